@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: Apache-2.0
+// System configuration: the parsed form of /etc/ccomm/signals.xml.
+//
+// One file describes the whole system (every node, every signal), so the same file is
+// flashed to every board. Signal ids are the signals' positions in the file and node ids
+// the nodes' positions; both are identical on every board that loads the same file,
+// which the wire format checks through `hash`.
+//
+// Parsing happens once at start-up (it allocates freely); nothing here is used on a
+// real-time path.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ccomm {
+
+enum class ValueType : uint8_t {  // wire codes, see docs/protocol.md
+  kBool = 1,
+  kInt32 = 2,
+  kUint32 = 3,
+  kInt64 = 4,
+  kFloat = 5,
+  kDouble = 6,
+};
+
+/// Bytes of one element of `t` on the wire and in shared memory (bool = 1 byte).
+size_t ValueTypeSize(ValueType t);
+/// "bool", "int32", ... ; nullptr for an unknown code.
+const char* ValueTypeName(ValueType t);
+/// Parses a type name; false if unknown.
+bool ParseValueType(const std::string& name, ValueType* out);
+
+enum class SignalKind : uint8_t { kState = 0, kEvent = 1 };
+enum class TransportKind : uint8_t { kRaw = 0, kUdp = 1 };
+
+constexpr uint32_t kMaxSignals = 4096;
+constexpr uint32_t kMaxNodes = 64;
+constexpr uint32_t kMaxArrayCount = 1024;
+constexpr uint32_t kMaxNameLength = 63;
+/// Largest value (count * element size) one signal may carry; it must fit in one frame.
+constexpr uint32_t kMaxValueBytes = 1024;
+
+struct RealtimeConfig {
+  bool mlockall = true;
+  int priority = 0;   // SCHED_FIFO priority for ccommd's I/O threads; 0 = SCHED_OTHER
+  int cpu = -1;       // CPU affinity for ccommd's I/O threads; -1 = any
+  uint32_t spin_us = 0;  // busy-poll window after activity before sleeping (0 = pure event-driven)
+};
+
+struct NodeConfig {
+  std::string name;
+  std::string interface;       // network interface, e.g. "eth0"
+  bool has_mac = false;
+  uint8_t mac[6] = {};         // unicast destination for raw frames; broadcast if !has_mac
+  std::string ip;              // IPv4 unicast address for UDP (dotted quad), may be empty
+  std::string multicast;       // optional IPv4 multicast group for UDP
+  TransportKind transport = TransportKind::kRaw;
+  RealtimeConfig realtime;
+  int line = 0;                // line of <node> in the file, for messages
+};
+
+struct SignalConfig {
+  std::string name;
+  ValueType type = ValueType::kDouble;
+  uint32_t count = 1;          // array length; 1 = scalar
+  SignalKind kind = SignalKind::kState;
+  uint32_t producer = 0;       // node id
+  std::vector<uint32_t> consumers;  // node ids
+  uint32_t stale_after_ms = 0;  // 0 = never goes stale
+  bool has_safe_value = false;
+  std::vector<uint8_t> safe_value;  // count * element size bytes, host byte order
+  uint32_t period_us = 0;      // 0 = event-driven (sent on every write); >0 = sent every period,
+                               // batched with every other due signal for the same destination.
+                               // XML: period_ms="1" or "0.1", or rate_hz="1000" (one of them)
+  uint32_t queue_depth = 64;   // event signals: ring capacity (power of two)
+  int line = 0;
+
+  size_t value_bytes() const { return count * ValueTypeSize(type); }
+};
+
+struct NetworkConfig {
+  uint16_t ethertype = 0x88B5;
+  uint16_t udp_port = 47800;
+  uint32_t heartbeat_ms = 100;
+  uint32_t peer_timeout_ms = 300;
+  std::string auth_key_file;   // empty = no authentication
+};
+
+struct SystemConfig {
+  std::string path;            // file it was read from
+  NetworkConfig network;
+  std::vector<NodeConfig> nodes;
+  std::vector<SignalConfig> signals;
+  uint32_t hash = 0;           // FNV-1a over a canonical form of what both ends must agree on
+                               // (node names/order, signal name/type/count/kind/producer/
+                               // consumers, ethertype, udp port); not whitespace or comments,
+                               // not local policy (stale_after, safe values, realtime). Frames carry it.
+
+  /// Node id by name, or -1.
+  int FindNode(const std::string& name) const;
+  /// Signal id by name, or -1.
+  int FindSignal(const std::string& name) const;
+};
+
+/// Loads and validates `path`. On failure returns false and fills `error` with one or
+/// more lines "FILE:LINE: error: MESSAGE". On success every cross reference (producer,
+/// consumers) is resolved and every limit above holds.
+bool LoadConfig(const std::string& path, SystemConfig* out, std::string* error);
+/// Same, from text in memory; `path` is used only in messages.
+bool ParseConfig(const std::string& text, const std::string& path, SystemConfig* out,
+                 std::string* error);
+
+}  // namespace ccomm

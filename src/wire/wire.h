@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm wire format v1: fixed-width, network byte order. Specified in docs/protocol.md;
+// the hex test vectors there are the ones wire_test.cpp checks.
+//
+// Encoding and decoding work on caller-provided buffers, never allocate and never read
+// or write outside [buf, buf + len): they are safe on the daemon's real-time paths and
+// on any bytes from the wire.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace ccomm {
+namespace wire {
+
+constexpr uint32_t kMagic = 0x43434D57;  // "CCMW"
+constexpr uint8_t kVersion = 1;
+constexpr size_t kHeaderSize = 32;
+constexpr size_t kEntryHeaderSize = 24;
+constexpr size_t kAuthTagSize = 16;
+constexpr size_t kMaxFrameSize = 1472;  // fits a UDP datagram in a 1500-byte MTU; raw frames use the same bound
+
+enum FrameFlags : uint8_t {
+  kFlagHeartbeat = 1u << 0,  // frame carries no entries, only liveness
+  kFlagAuth = 1u << 1,       // a kAuthTagSize-byte tag follows the entries
+};
+
+enum EntryFlags : uint8_t {
+  kEntryEvent = 1u << 0,  // entry is an event (queued), not a state (last value wins)
+};
+
+struct FrameHeader {
+  uint8_t version = kVersion;
+  uint8_t flags = 0;
+  uint16_t sender = 0;        // node id of the sender (position in signals.xml)
+  uint32_t config_hash = 0;   // SystemConfig::hash of the sender's configuration
+  uint32_t seq = 0;           // per sender and destination, +1 per frame
+  uint64_t send_time_ns = 0;  // sender's CLOCK_MONOTONIC at send
+  uint16_t entry_count = 0;
+  uint16_t payload_len = 0;   // bytes of entries after the header (excludes the tag)
+};
+
+/// One decoded entry. `value` points into the frame buffer (no copy); the bytes are
+/// in network byte order and are converted by ValueToHost().
+struct EntryView {
+  uint16_t signal = 0;
+  uint8_t type = 0;
+  uint8_t flags = 0;
+  uint16_t count = 0;
+  uint16_t value_len = 0;
+  uint32_t seq = 0;
+  uint64_t source_time_ns = 0;  // producer's CLOCK_MONOTONIC when the value was written
+  const uint8_t* value = nullptr;
+};
+
+enum class DecodeError : uint8_t {
+  kOk = 0,
+  kTooShort,      // fewer bytes than a header, or than payload_len says
+  kBadMagic,
+  kBadVersion,
+  kBadHeader,     // reserved bits set, or inconsistent flags / counts
+  kBadEntry,      // entry runs past payload, unknown type, count/len mismatch, non-zero padding
+  kTrailingBytes, // bytes after the declared payload (and tag)
+};
+const char* DecodeErrorName(DecodeError e);
+
+/// Builds a frame in `buf` (capacity `cap`): call Begin, Add per entry, Finish.
+class FrameWriter {
+ public:
+  FrameWriter(uint8_t* buf, size_t cap) : buf_(buf), cap_(cap) {}
+  void Begin(const FrameHeader& h);
+  /// Appends an entry; `value` holds count elements in host byte order. Returns false
+  /// (frame unchanged) if it would not fit.
+  bool Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
+           uint64_t source_time_ns, const void* value, size_t value_len);
+  /// Writes entry_count / payload_len into the header; returns the frame length
+  /// (without any auth tag, which the caller appends and then sets kFlagAuth).
+  size_t Finish();
+  size_t size() const { return len_; }
+  uint16_t entries() const { return count_; }
+  /// Bytes an entry with value_len value bytes takes on the wire (padded to 8).
+  static size_t EntrySize(size_t value_len) { return kEntryHeaderSize + ((value_len + 7u) & ~size_t{7}); }
+
+ private:
+  uint8_t* buf_;
+  size_t cap_;
+  size_t len_ = 0;
+  uint16_t count_ = 0;
+};
+
+/// Validates the whole frame (header and every entry) before anything is used. On kOk,
+/// `h` is filled and entries can be walked with EntryIterator.
+DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h);
+
+/// Walks the entries of a frame already accepted by DecodeHeader.
+class EntryIterator {
+ public:
+  EntryIterator(const uint8_t* buf, const FrameHeader& h)
+      : p_(buf + kHeaderSize), left_(h.entry_count) {}
+  bool Next(EntryView* e);
+
+ private:
+  const uint8_t* p_;
+  uint16_t left_;
+};
+
+/// Converts `count` elements of `type` from network to host byte order.
+void ValueToHost(uint8_t type, const uint8_t* src, void* dst, size_t count);
+
+}  // namespace wire
+}  // namespace ccomm

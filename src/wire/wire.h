@@ -38,7 +38,9 @@ struct FrameHeader {
   uint64_t send_time_ns = 0;  // sender's CLOCK_MONOTONIC at send
   uint16_t entry_count = 0;
   uint16_t payload_len = 0;   // bytes of entries after the header (excludes the tag)
+  uint16_t dest = 0;          // destination node id (offset 28), kDestAll = every node
 };
+constexpr uint16_t kDestAll = 0xFFFF;
 
 /// One decoded entry. `value` points into the frame buffer (no copy); the bytes are
 /// in network byte order and are converted by ValueToHost().
@@ -69,12 +71,18 @@ class FrameWriter {
  public:
   FrameWriter(uint8_t* buf, size_t cap) : buf_(buf), cap_(cap) {}
   void Begin(const FrameHeader& h);
-  /// Appends an entry; `value` holds count elements in host byte order. Returns false
-  /// (frame unchanged) if it would not fit.
+  /// Appends an entry; `value` holds count elements in host byte order (bool: one byte
+  /// each, non-zero = true). Returns false (frame unchanged) if it would not fit, if the
+  /// arguments are invalid (type, count 0, value_len != count * size, flags) or if the
+  /// frame is a heartbeat.
   bool Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
            uint64_t source_time_ns, const void* value, size_t value_len);
   /// Writes entry_count / payload_len into the header; returns the frame length
-  /// (without any auth tag, which the caller appends and then sets kFlagAuth).
+  /// without any auth tag, or 0 if Begin failed (cap < kHeaderSize, unknown flag bits)
+  /// or a frame without kFlagHeartbeat has no entry (such a frame is invalid).
+  /// If a tag will follow, pass kFlagAuth to Begin: the writer then keeps kAuthTagSize
+  /// bytes free so that frame + tag <= kMaxFrameSize; the caller computes the tag over
+  /// the returned bytes and stores it at buf + Finish().
   size_t Finish();
   size_t size() const { return len_; }
   uint16_t entries() const { return count_; }
@@ -84,13 +92,20 @@ class FrameWriter {
  private:
   uint8_t* buf_;
   size_t cap_;
-  size_t len_ = 0;
+  size_t len_ = 0;     // 0 until a successful Begin
+  size_t limit_ = 0;   // min(cap, kMaxFrameSize - tag room), set by Begin
   uint16_t count_ = 0;
 };
 
 /// Validates the whole frame (header and every entry) before anything is used. On kOk,
-/// `h` is filled and entries can be walked with EntryIterator.
+/// `h` is filled and entries can be walked with EntryIterator; otherwise `h` is untouched.
 DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h);
+
+/// Ethernet pads payloads shorter than this with zero bytes (a plain heartbeat is 32).
+constexpr size_t kEthMinPayload = 46;
+/// For frames received over raw Ethernet: if `len` <= kEthMinPayload, the frame declares a
+/// shorter length and every byte after it is zero, returns that length; otherwise `len`.
+size_t TrimEthernetPadding(const uint8_t* buf, size_t len);
 
 /// Walks the entries of a frame already accepted by DecodeHeader.
 class EntryIterator {

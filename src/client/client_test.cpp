@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: Apache-2.0
+// The C and C++ APIs over a segment created in-process (no daemon needed).
+#include "ccomm/ccomm.h"
+#include "ccomm/ccomm.hpp"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <array>
+#include <thread>
+
+#include "store/segment.h"
+#include "common/platform.h"
+#include "store/test_config.h"
+
+namespace ccomm {
+namespace {
+
+using testing::MakeSignal;
+using testing::TwoNodeConfig;
+
+class ClientTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("client").c_str(), 1);
+    auto pos = MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
+    auto sp = MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
+    sp.stale_after_ms = 20;
+    sp.has_safe_value = true;
+    double safe = -1.0;
+    sp.safe_value.resize(8);
+    memcpy(sp.safe_value.data(), &safe, 8);
+    auto arr = MakeSignal("arr", ValueType::kInt32, 3, SignalKind::kState, 0, {});
+    auto ev = MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 0, {});
+    ev.queue_depth = 8;
+    auto local = MakeSignal("local", ValueType::kFloat, 1, SignalKind::kState, 0, {0});
+    local.stale_after_ms = 1000;
+    cfg_ = TwoNodeConfig({pos, sp, arr, ev, local});
+    std::string err;
+    bool adopted;
+    ASSERT_EQ(seg_a_.CreateOrAdopt(cfg_, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;
+    ASSERT_EQ(seg_b_.CreateOrAdopt(cfg_, 1, store::SegmentName("b"), -1, &adopted, &err), 0) << err;
+  }
+  void TearDown() override {
+    platform::ShmUnlink(store::SegmentName("a").c_str());
+    platform::ShmUnlink(store::SegmentName("b").c_str());
+  }
+  SystemConfig cfg_;
+  store::Segment seg_a_, seg_b_;
+};
+
+TEST_F(ClientTest, OpenFindDescribe) {
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  EXPECT_STREQ(ccomm_node_name(c), "a");
+  EXPECT_EQ(ccomm_signal_count(c), 5);
+  ccomm_signal s = ccomm_find(c, "arr");
+  ASSERT_EQ(s, 2);
+  ccomm_signal_desc d;
+  ASSERT_EQ(ccomm_describe(c, s, &d), 0);
+  EXPECT_STREQ(d.name, "arr");
+  EXPECT_EQ(d.type, CCOMM_INT32);
+  EXPECT_EQ(d.count, 3u);
+  EXPECT_EQ(d.value_bytes, 12u);
+  EXPECT_EQ(d.produced_here, 1);
+  EXPECT_STREQ(d.producer, "a");
+  EXPECT_EQ(ccomm_find(c, "missing"), CCOMM_E_NOENT);
+  ccomm_close(c);
+  ccomm_client* none = nullptr;
+  EXPECT_EQ(ccomm_open("nosuchnode", 0, &none), CCOMM_E_NOENT);
+  EXPECT_EQ(none, nullptr);
+}
+
+TEST_F(ClientTest, ApiMisuseIsRejectedNotFatal) {
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  double v = 0;
+  EXPECT_EQ(ccomm_read(nullptr, 0, &v, 8, nullptr), CCOMM_E_INVAL);
+  EXPECT_EQ(ccomm_read(c, 99, &v, 8, nullptr), CCOMM_E_INVAL);
+  EXPECT_EQ(ccomm_read(c, -1, &v, 8, nullptr), CCOMM_E_INVAL);
+  EXPECT_EQ(ccomm_read(c, 0, &v, 4, nullptr), CCOMM_E_TYPE);
+  EXPECT_EQ(ccomm_write(c, 0, nullptr, 8), CCOMM_E_INVAL);
+  EXPECT_EQ(ccomm_write(c, 1, &v, 8), CCOMM_E_PERM);  // "sp" is produced by b
+  int32_t i = 0;
+  EXPECT_EQ(ccomm_read_int32(c, 0, &i, nullptr), CCOMM_E_TYPE);
+  EXPECT_EQ(ccomm_write_float(c, 0, 1.0f), CCOMM_E_TYPE);
+  EXPECT_STRNE(ccomm_strerror(CCOMM_E_PERM), "unknown code");
+  ccomm_close(c);
+  ccomm_close(nullptr);  // harmless
+}
+
+TEST_F(ClientTest, StateReadsSayFreshStaleNeverWithSafeValue) {
+  ccomm_client *a = nullptr, *b = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &a), 0);
+  ASSERT_EQ(ccomm_open("b", 0, &b), 0);
+  ccomm_signal sp = ccomm_find(a, "sp");
+  double v = 123;
+  ccomm_info info;
+  EXPECT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_NEVER);
+  EXPECT_EQ(info.status, CCOMM_NEVER);
+  EXPECT_EQ(v, -1.0);  // the safe value
+  EXPECT_TRUE(info.flags & CCOMM_INFO_SAFE_VALUE);
+  EXPECT_EQ(info.age_ns, -1);
+  // "sp" on node a is written by ccommd from the network; simulate that delivery.
+  double in = 7.5;
+  ASSERT_EQ(store::StateWrite(seg_a_.state(1), &in, 42, 5, platform::MonotonicNs()), store::StoreResult::kOk);
+  EXPECT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);
+  EXPECT_EQ(v, 7.5);
+  EXPECT_EQ(info.seq, 42u);
+  EXPECT_EQ(info.source_time_ns, 5u);
+  EXPECT_GE(info.age_ns, 0);
+  EXPECT_EQ(info.flags, 0u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  EXPECT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_STALE);
+  EXPECT_EQ(v, -1.0);
+  EXPECT_GT(info.age_ns, 20 * 1000000);
+  ccomm_close(a);
+  ccomm_close(b);
+}
+
+TEST_F(ClientTest, TwoAppsOnOneNodeThroughSharedMemory) {
+  ccomm::Client writer("a"), reader("a");
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(reader.ok());
+  auto w = writer.signal<float>("local");
+  auto r = reader.signal<float>("local");
+  ASSERT_TRUE(w.valid());
+  EXPECT_TRUE(r.read().never());
+  ASSERT_EQ(w.write(3.25f), 0);
+  auto got = r.read();
+  EXPECT_TRUE(got.fresh());
+  EXPECT_EQ(got.value, 3.25f);
+  EXPECT_EQ(got.info.seq, 1u);
+  auto arr_w = writer.signal<std::array<int32_t, 3>>("arr");
+  auto arr_r = reader.signal<std::array<int32_t, 3>>("arr");
+  ASSERT_TRUE(arr_w.valid());
+  ASSERT_EQ(arr_w.write({1, -2, 3}), 0);
+  auto ga = arr_r.read();
+  EXPECT_EQ(ga.value[1], -2);
+  // Wrong type / count is refused at lookup.
+  EXPECT_FALSE(reader.signal<double>("local").valid());
+  EXPECT_EQ(reader.last_error(), CCOMM_E_TYPE);
+  EXPECT_FALSE((reader.signal<std::array<int32_t, 2>>("arr").valid()));
+}
+
+TEST_F(ClientTest, EventsArriveOncePerReader) {
+  ccomm::Client w("a"), r1("a"), r2("a");
+  auto e = w.signal<bool>("estop");
+  auto e1 = r1.signal<bool>("estop");
+  auto e2 = r2.signal<bool>("estop");
+  EXPECT_TRUE(e1.read().empty());
+  ASSERT_EQ(e.write(true), 0);
+  ASSERT_EQ(e.write(false), 0);
+  for (auto* s : {&e1, &e2}) {
+    auto x = s->read();
+    EXPECT_TRUE(x.fresh());
+    EXPECT_TRUE(x.value);
+    x = s->read();
+    EXPECT_TRUE(x.fresh());
+    EXPECT_FALSE(x.value);
+    EXPECT_TRUE(s->read().empty());
+  }
+  // Overrun of a local (not forwarded) ring is reported to the slow reader.
+  for (int i = 0; i < 20; ++i) ASSERT_EQ(e.write(i & 1), 0);
+  int n = 0;
+  ccomm::Reading<bool> x;
+  while ((x = e1.read()).fresh()) n++;
+  EXPECT_EQ(n, 8);
+  EXPECT_EQ(x.info.lost, 12u);
+}
+
+TEST_F(ClientTest, WaitWakesOnWriteAndTimesOut) {
+  ccomm::Client w("a"), r("a");
+  auto s = w.signal<float>("local");
+  EXPECT_FALSE(r.wait(10));
+  std::thread t([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    s.write(1.0f);
+  });
+  EXPECT_TRUE(r.wait(5000));
+  t.join();
+}
+
+TEST_F(ClientTest, RetiredSegmentIsReported) {
+  ccomm::Client c("a");
+  auto s = c.signal<float>("local");
+  seg_a_.header()->state.store(store::kRetired);
+  EXPECT_EQ(s.read().code, CCOMM_E_RETIRED);
+  EXPECT_EQ(s.write(1.0f), CCOMM_E_RETIRED);
+}
+
+}  // namespace
+}  // namespace ccomm

@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/platform.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <linux/futex.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
+namespace ccomm {
+namespace platform {
+
+static_assert(sizeof(std::atomic<uint32_t>) == sizeof(uint32_t), "futex word must be a plain u32");
+
+uint64_t MonotonicNs() {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+// Shared (not FUTEX_PRIVATE_FLAG): the word lives in a segment mapped by several processes.
+void FutexWake(std::atomic<uint32_t>* word, int n) {
+  syscall(SYS_futex, reinterpret_cast<uint32_t*>(word), FUTEX_WAKE, n, nullptr, nullptr, 0);
+}
+
+bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_ns) {
+  struct timespec ts;
+  struct timespec* tsp = nullptr;
+  if (timeout_ns >= 0) {
+    ts.tv_sec = timeout_ns / 1000000000;
+    ts.tv_nsec = timeout_ns % 1000000000;
+    tsp = &ts;
+  }
+  long r = syscall(SYS_futex, reinterpret_cast<uint32_t*>(word), FUTEX_WAIT, expected, tsp, nullptr, 0);
+  return !(r != 0 && errno == ETIMEDOUT);
+}
+
+int ShmOpen(const char* name, bool create_exclusive, int mode) {
+  int flags = O_RDWR | O_CLOEXEC | (create_exclusive ? (O_CREAT | O_EXCL) : 0);
+  int fd = shm_open(name, flags, static_cast<mode_t>(mode));
+  if (fd < 0) return -errno;
+  if (create_exclusive) fchmod(fd, static_cast<mode_t>(mode));  // umask must not narrow it
+  return fd;
+}
+
+int ShmUnlink(const char* name) { return shm_unlink(name) == 0 ? 0 : -errno; }
+
+void* MapShared(int fd, size_t size) {
+  void* p = mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  return p == MAP_FAILED ? nullptr : p;
+}
+
+void Unmap(void* p, size_t size) {
+  if (p) munmap(p, size);
+}
+
+int FileSize(int fd, size_t* size) {
+  struct stat st;
+  if (fstat(fd, &st) != 0) return -errno;
+  *size = static_cast<size_t>(st.st_size);
+  return 0;
+}
+
+int Truncate(int fd, size_t size) { return ftruncate(fd, static_cast<off_t>(size)) == 0 ? 0 : -errno; }
+
+void CloseFd(int fd) {
+  if (fd >= 0) close(fd);
+}
+
+int LockAllMemory() { return mlockall(MCL_CURRENT | MCL_FUTURE) == 0 ? 0 : -errno; }
+
+int SetFifoPriority(int priority) {
+  struct sched_param sp;
+  memset(&sp, 0, sizeof sp);
+  sp.sched_priority = priority;
+  return -pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+}
+
+int PinToCpu(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  return -pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+}
+
+void PrefaultStack(size_t bytes) {
+  volatile unsigned char buf[64 * 1024];
+  size_t n = bytes < sizeof buf ? bytes : sizeof buf;
+  for (size_t i = 0; i < n; i += 4096) buf[i] = 0;
+}
+
+bool HostName(char* buf, size_t cap) {
+  if (gethostname(buf, cap) != 0) return false;
+  buf[cap - 1] = '\0';
+  char* dot = strchr(buf, '.');  // node names are short host names
+  if (dot) *dot = '\0';
+  return buf[0] != '\0';
+}
+
+}  // namespace platform
+
+static LogLevel g_max_level = LogLevel::kInfo;
+static bool g_sd_prefixes = false;
+
+void SetLogVerbosity(LogLevel max_level) { g_max_level = max_level; }
+void SetLogPrefixes(bool sd_prefixes) { g_sd_prefixes = sd_prefixes; }
+
+void Log(LogLevel level, const char* fmt, ...) {
+  if (static_cast<int>(level) > static_cast<int>(g_max_level)) return;
+  char line[1024];
+  int off = 0;
+  if (g_sd_prefixes) off = snprintf(line, sizeof line, "<%d>", static_cast<int>(level));
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
+  va_end(ap);
+  fprintf(stderr, "%s\n", line);
+}
+
+}  // namespace ccomm

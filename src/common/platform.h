@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: Apache-2.0
+// Every OS call ccomm makes goes through this header (zenoh-pico style), so a port
+// (Xenomai, another RTOS) touches one file. Functions marked [rt] are safe on a
+// real-time path: no allocation, no locks, and no syscall except where stated.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <atomic>
+
+namespace ccomm {
+namespace platform {
+
+/// [rt] CLOCK_MONOTONIC in ns (vDSO, no syscall on Linux).
+uint64_t MonotonicNs();
+
+/// [rt] Hint to the CPU inside a spin loop.
+inline void CpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__) || (defined(__arm__) && (__ARM_ARCH >= 7))
+  __asm__ __volatile__("yield");
+#endif
+}
+
+/// [rt] Wakes up to `n` waiters on a futex word in shared memory (one non-blocking syscall).
+void FutexWake(std::atomic<uint32_t>* word, int n);
+/// Blocks while *word == expected, at most timeout_ns (<0 = forever). Returns false on timeout.
+bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_ns);
+
+/// Shared memory. Names are POSIX shm names ("/ccomm.node").
+int ShmOpen(const char* name, bool create_exclusive, int mode);  // fd or -errno
+int ShmUnlink(const char* name);                                   // 0 or -errno
+void* MapShared(int fd, size_t size);                              // nullptr on error (errno set)
+void Unmap(void* p, size_t size);
+int FileSize(int fd, size_t* size);                                // 0 or -errno
+int Truncate(int fd, size_t size);                                 // 0 or -errno
+void CloseFd(int fd);
+
+/// Locks current and future memory; returns 0 or -errno.
+int LockAllMemory();
+/// SCHED_FIFO with `priority` (1..99) for the calling thread; 0 or -errno.
+int SetFifoPriority(int priority);
+/// Pins the calling thread to `cpu`; 0 or -errno.
+int PinToCpu(int cpu);
+/// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
+void PrefaultStack(size_t bytes);
+
+/// Hostname (for the default node name); false on error.
+bool HostName(char* buf, size_t cap);
+
+}  // namespace platform
+
+/// Logging for start-up, shutdown and rare events; never used per message. Lines go to
+/// stderr with sd-daemon priority prefixes ("<3>"), which journald understands.
+enum class LogLevel { kError = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
+void Log(LogLevel level, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void SetLogVerbosity(LogLevel max_level);
+void SetLogPrefixes(bool sd_prefixes);
+
+}  // namespace ccomm

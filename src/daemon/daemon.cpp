@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: Apache-2.0
+// Start-up, supervision and shutdown of the forwarding engine (send/receive paths are
+// in tx_path.cpp and rx_path.cpp).
+#include "daemon/daemon.h"
+
+#include <errno.h>
+#include <grp.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "common/platform.h"
+
+namespace ccomm {
+
+Daemon::~Daemon() { Shutdown(); }
+
+int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions& opt,
+                  std::string* error) {
+  cfg_ = &cfg;
+  self_ = node_id;
+  opt_ = opt;
+  const NodeConfig& self = cfg.nodes[node_id];
+  const size_t n = cfg.signals.size(), m = cfg.nodes.size();
+  heartbeat_ns_ = uint64_t{cfg.network.heartbeat_ms} * 1000000;
+  peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
+
+  // Who do we talk to, and which signals go where.
+  peers_tx_ = std::vector<PeerTx>(m);
+  peers_rx_.assign(m, PeerRx());
+  consumers_.assign(n, {});
+  due_ns_.assign(n, 0);
+  fwd_cursors_.assign(n, store::RingCursor());
+  last_rx_seq_.assign(n, 0);
+  fresh_.assign(n, 0);
+  TransportKind kind = opt.force_udp ? TransportKind::kUdp : self.transport;
+  for (size_t i = 0; i < n; ++i) {
+    const SignalConfig& s = cfg.signals[i];
+    bool here = s.producer == node_id;
+    bool consumed_here = false;
+    for (uint32_t c : s.consumers) {
+      if (here && c != node_id) {
+        consumers_[i].push_back(c);
+        peers_tx_[c].active = true;
+      }
+      if (c == node_id) consumed_here = true;
+    }
+    if (!here && consumed_here) {
+      peers_tx_[s.producer].active = true;  // heartbeats let the producer supervise us too
+      consumed_.push_back(static_cast<uint32_t>(i));
+    }
+    if (here && !consumers_[i].empty() && s.period_us) periodic_.push_back(static_cast<uint32_t>(i));
+  }
+  for (uint32_t p = 0; p < m; ++p) {
+    PeerTx& pt = peers_tx_[p];
+    if (!pt.active) continue;
+    TransportKind pk = opt.force_udp ? TransportKind::kUdp : cfg.nodes[p].transport;
+    if (pk != kind) {
+      *error = "node '" + self.name + "' uses " + (kind == TransportKind::kRaw ? "raw" : "udp") +
+               " but its peer '" + cfg.nodes[p].name + "' uses " +
+               (pk == TransportKind::kRaw ? "raw" : "udp") + ": nodes that exchange signals need the same transport";
+      return -EINVAL;
+    }
+    if (!PeerAddressFor(cfg.network, cfg.nodes[p], kind, &pt.addr)) {
+      *error = "peer '" + cfg.nodes[p].name + "' has no usable ip/multicast for UDP";
+      return -EINVAL;
+    }
+    pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
+  }
+
+  // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
+  int gid = -1;
+  if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
+  int r = segment_.CreateOrAdopt(cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
+  if (r != 0) return r;
+  for (size_t i = 0; i < n; ++i) {
+    const auto& d = segment_.dir(static_cast<uint32_t>(i));
+    if ((d.flags & store::kSigEvent) && (d.flags & store::kSigForwarded)) {
+      // Resume where the previous ccommd stopped: queued events are still sent.
+      fwd_cursors_[i].next = segment_.ring(static_cast<uint32_t>(i)).ring->fwd_cursor.load();
+    }
+  }
+
+  r = kind == TransportKind::kRaw ? OpenRawTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error)
+                                  : OpenUdpTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error);
+  if (r != 0) return r;
+
+  uint64_t now = platform::MonotonicNs();
+  for (uint32_t id : periodic_) due_ns_[id] = now;
+  store::SegmentHeader* h = segment_.header();
+  h->daemon_pid.store(static_cast<int32_t>(getpid()), std::memory_order_release);
+  h->daemon_heartbeat_ns.store(now, std::memory_order_release);
+  running_.store(true);
+  return 0;
+}
+
+void Daemon::Supervise(uint64_t now) {
+  store::SegmentHeader* h = segment_.header();
+  h->daemon_heartbeat_ns.store(now, std::memory_order_release);
+  for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
+    if (!peers_tx_[p].active) continue;
+    store::PeerStats& ps = segment_.peer(p);
+    uint64_t last = ps.last_rx_ns.load(std::memory_order_acquire);
+    bool alive = ps.alive.load(std::memory_order_relaxed) != 0;
+    if (alive && now - last > peer_timeout_ns_) {
+      ps.alive.store(0, std::memory_order_release);
+      ps.down_transitions.fetch_add(1, std::memory_order_relaxed);
+      Log(LogLevel::kWarning, "peer '%s' lost: nothing received for %u ms", cfg_->nodes[p].name.c_str(),
+          cfg_->network.peer_timeout_ms);
+    }
+  }
+  for (uint32_t id : consumed_) {
+    const SignalConfig& s = cfg_->signals[id];
+    if (!s.stale_after_ms) continue;
+    uint64_t last = segment_.stats(id).last_rx_ns.load(std::memory_order_relaxed);
+    bool fresh = last && now - last <= uint64_t{s.stale_after_ms} * 1000000;
+    if (fresh_[id] && !fresh) segment_.stats(id).stale_transitions.fetch_add(1, std::memory_order_relaxed);
+    fresh_[id] = fresh;
+  }
+}
+
+void Daemon::RequestStop() {
+  running_.store(false);
+  if (segment_.is_open()) {
+    segment_.header()->tx_doorbell.fetch_add(1);
+    platform::FutexWake(&segment_.header()->tx_doorbell, 1);
+  }
+}
+
+void Daemon::Shutdown() {
+  running_.store(false);
+  transport_.Close();
+  if (segment_.is_open()) {
+    segment_.header()->daemon_pid.store(0, std::memory_order_release);
+    segment_.Close();  // the segment stays: clients keep reading (stale) values
+  }
+}
+
+}  // namespace ccomm

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccommd's forwarding engine: a send thread (woken by the shared-memory doorbell or
+// its periodic/heartbeat deadline), a receive thread (blocked in the socket), and a
+// supervision tick on the main thread. Everything is allocated in Start(); the three
+// loops never allocate (daemon_alloc_test checks).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config/config.h"
+#include "daemon/transport.h"
+#include "store/segment.h"
+#include "wire/wire.h"
+
+namespace ccomm {
+
+struct DaemonOptions {
+  std::string config_path = "/etc/ccomm/signals.xml";
+  std::string node;            // empty = hostname
+  bool force_udp = false;      // --transport udp: ignore transport="raw" in the file
+  bool check_only = false;
+  bool no_realtime = false;    // --no-rt: skip mlockall / SCHED_FIFO (tests, unprivileged)
+  int verbosity = 6;           // LogLevel
+  int recv_timeout_ms = 50;
+};
+
+class Daemon {
+ public:
+  Daemon() = default;
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+  ~Daemon();
+
+  /// Creates/adopts the segment, opens the transport, preallocates everything.
+  int Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions& opt, std::string* error);
+  void RunTx();   // send thread body, returns after RequestStop()
+  void RunRx();   // receive thread body
+  /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call every ~10 ms.
+  void Supervise(uint64_t now_ns);
+  void RequestStop();
+  /// Detaches from the segment (which stays for the clients: their values go stale).
+  void Shutdown();
+
+  /// Loop iteration counters, for the watchdog: both must advance between pings.
+  uint64_t tx_loops() const { return tx_loops_.load(std::memory_order_relaxed); }
+  uint64_t rx_loops() const { return rx_loops_.load(std::memory_order_relaxed); }
+  const store::Segment& segment() const { return segment_; }
+  const char* transport_name() const { return transport_.ops ? transport_.ops->name : "none"; }
+  bool adopted_segment() const { return adopted_; }
+
+ private:
+  struct PeerTx {
+    bool active = false;        // we exchange signals with this node
+    PeerAddress addr;
+    uint32_t seq = 0;
+    uint64_t last_tx_ns = 0;
+    wire::FrameWriter writer{nullptr, 0};
+    bool open = false;          // writer holds a begun frame
+    uint8_t buf[wire::kMaxFrameSize];
+  };
+  struct PeerRx {
+    bool seen = false;
+    uint32_t expected = 0;
+  };
+
+  void CollectSignal(uint32_t id, uint64_t now, bool periodic);
+  void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
+                const void* value, uint64_t now);
+  void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
+  void FlushPeer(uint32_t peer);
+  void HandleFrame(const uint8_t* buf, size_t len, uint64_t now);
+  void Count(store::DaemonCounter c) {
+    segment_.header()->daemon_counters[c].fetch_add(1, std::memory_order_relaxed);
+  }
+
+  const SystemConfig* cfg_ = nullptr;
+  uint32_t self_ = 0;
+  DaemonOptions opt_;
+  store::Segment segment_;
+  bool adopted_ = false;
+  Transport transport_;
+  std::atomic<bool> running_{false};
+  std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};
+
+  // Preallocated in Start().
+  std::vector<PeerTx> peers_tx_;
+  std::vector<PeerRx> peers_rx_;
+  std::vector<std::vector<uint32_t>> consumers_;  // signal -> remote consumer node ids
+  std::vector<uint32_t> periodic_;                // forwarded periodic signal ids
+  std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
+  std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
+  std::vector<uint64_t> last_rx_seq_;             // signal -> last value_seq received
+  std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
+  std::vector<uint32_t> consumed_;                // ids of signals consumed here
+  uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
+  alignas(8) uint8_t tx_value_[kMaxValueBytes];
+  alignas(8) uint8_t rx_value_[kMaxValueBytes];
+  alignas(8) uint8_t rx_buf_[2048];
+};
+
+}  // namespace ccomm

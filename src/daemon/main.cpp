@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccommd: one per board. Loads signals.xml, creates the node's shared-memory segment,
+// forwards signals over raw Ethernet or UDP. Started by systemd (Type=notify).
+#include <errno.h>
+#include <getopt.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <string>
+
+#include "common/platform.h"
+#include "config/config.h"
+#include "daemon/daemon.h"
+#include "daemon/sd_notify.h"
+
+// Hooks for the allocation-counting test (tests/alloc_counter.cpp preloads them);
+// weak, so they cost nothing in a normal run.
+extern "C" void ccomm_steady_state_begin() __attribute__((weak));
+extern "C" void ccomm_steady_state_end() __attribute__((weak));
+
+namespace {
+
+const char kUsage[] =
+    "Usage: ccommd [OPTIONS]\n"
+    "Forward ccomm signals between this board's shared memory and the network.\n"
+    "\n"
+    "  -c, --config FILE     configuration (default /etc/ccomm/signals.xml)\n"
+    "  -n, --node NAME       this board's node in the file (default: $CCOMM_NODE, else hostname)\n"
+    "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
+    "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
+    "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
+    "  -v, --verbose         more log output (repeat for debug)\n"
+    "  -q, --quiet           warnings and errors only\n"
+    "  -h, --help            this text\n"
+    "  -V, --version         version\n"
+    "\n"
+    "Needs: CAP_NET_RAW for raw Ethernet (transport=\"raw\"), CAP_IPC_LOCK for mlockall and\n"
+    "CAP_SYS_NICE for SCHED_FIFO (<realtime priority=\"..\"/>); without them ccommd says so and\n"
+    "carries on where it can (without RT), or fails with what to do (raw sockets).\n"
+    "Environment: CCOMM_SHM_PREFIX (default \"/ccomm.\") names the segment /ccomm.NODE.\n"
+    "Exit status: 0 clean stop or valid config, 1 invalid config, 2 usage, 3 start-up failure.\n"
+    "See ccommd(8), docs/config.md and docs/protocol.md.\n";
+
+volatile sig_atomic_t g_stop = 0;
+
+void* TxThread(void* d) {
+  static_cast<ccomm::Daemon*>(d)->RunTx();
+  return nullptr;
+}
+void* RxThread(void* d) {
+  static_cast<ccomm::Daemon*>(d)->RunRx();
+  return nullptr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace ccomm;
+  DaemonOptions opt;
+  int verbosity = 6;
+  static const struct option kLong[] = {
+      {"config", required_argument, nullptr, 'c'}, {"node", required_argument, nullptr, 'n'},
+      {"check", optional_argument, nullptr, 'C'},  {"transport", required_argument, nullptr, 'T'},
+      {"no-rt", no_argument, nullptr, 'R'},        {"verbose", no_argument, nullptr, 'v'},
+      {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
+      {"version", no_argument, nullptr, 'V'},      {nullptr, 0, nullptr, 0}};
+  int ch;
+  while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
+    switch (ch) {
+      case 'c': opt.config_path = optarg; break;
+      case 'n': opt.node = optarg; break;
+      case 'C':
+        opt.check_only = true;
+        if (optarg) opt.config_path = optarg;
+        else if (optind < argc && argv[optind][0] != '-') opt.config_path = argv[optind++];
+        break;
+      case 'T':
+        if (strcmp(optarg, "udp") == 0) opt.force_udp = true;
+        else if (strcmp(optarg, "raw") != 0) {
+          fprintf(stderr, "ccommd: --transport takes 'udp' or 'raw', not '%s'\n", optarg);
+          return 2;
+        }
+        break;
+      case 'R': opt.no_realtime = true; break;
+      case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
+      case 'q': verbosity = 4; break;
+      case 'h': fputs(kUsage, stdout); return 0;
+      case 'V': printf("ccommd %s (wire v1, shm layout v1)\n", CCOMM_VERSION); return 0;
+      default: fputs(kUsage, stderr); return 2;
+    }
+  }
+  if (optind < argc) {
+    fprintf(stderr, "ccommd: unexpected argument '%s'\n%s", argv[optind], kUsage);
+    return 2;
+  }
+  SetLogVerbosity(static_cast<LogLevel>(verbosity));
+  SetLogPrefixes(getenv("JOURNAL_STREAM") != nullptr);
+
+  SystemConfig cfg;
+  std::string error;
+  if (!LoadConfig(opt.config_path, &cfg, &error)) {
+    fprintf(stderr, "%s", error.c_str());
+    if (!error.empty() && error.back() != '\n') fputc('\n', stderr);
+    return 1;
+  }
+  if (opt.check_only) {
+    printf("%s: ok (%zu nodes, %zu signals, hash %08x)\n", opt.config_path.c_str(), cfg.nodes.size(),
+           cfg.signals.size(), cfg.hash);
+    return 0;
+  }
+  if (opt.node.empty()) {
+    const char* env = getenv("CCOMM_NODE");
+    char host[64];
+    if (env && *env) opt.node = env;
+    else if (platform::HostName(host, sizeof host)) opt.node = host;
+  }
+  int node = cfg.FindNode(opt.node);
+  if (node < 0) {
+    std::string names;
+    for (const auto& n : cfg.nodes) names += (names.empty() ? "" : ", ") + n.name;
+    fprintf(stderr, "ccommd: %s has no node '%s' (nodes: %s); pass --node NAME or set the hostname\n",
+            opt.config_path.c_str(), opt.node.c_str(), names.c_str());
+    return 1;
+  }
+
+  // Signals are handled synchronously by the main thread; the I/O threads block them.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+
+  const NodeConfig& self = cfg.nodes[static_cast<size_t>(node)];
+  if (!opt.no_realtime && self.realtime.mlockall) {
+    int r = platform::LockAllMemory();
+    if (r != 0)
+      Log(LogLevel::kWarning, "mlockall failed (%s): page faults may add latency; needs CAP_IPC_LOCK or "
+          "LimitMEMLOCK=infinity", strerror(-r));
+  }
+
+  static Daemon daemon;  // large (frame buffers): not on the stack
+  int r = daemon.Start(cfg, static_cast<uint32_t>(node), opt, &error);
+  if (r != 0) {
+    Log(LogLevel::kError, "ccommd: %s", error.c_str());
+    return 3;
+  }
+  Log(LogLevel::kInfo, "ccommd %s: node '%s', %zu signals, transport %s, segment %s (%s), config hash %08x",
+      CCOMM_VERSION, self.name.c_str(), cfg.signals.size(), daemon.transport_name(),
+      store::SegmentName(self.name).c_str(), daemon.adopted_segment() ? "re-adopted" : "created", cfg.hash);
+
+  pthread_t tx, rx;
+  pthread_create(&tx, nullptr, TxThread, &daemon);
+  pthread_create(&rx, nullptr, RxThread, &daemon);
+  sd::NotifyReady();
+  if (ccomm_steady_state_begin) ccomm_steady_state_begin();
+
+  const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
+  uint64_t last_ping = 0, last_tx = 0, last_rx = 0;
+  for (;;) {
+    struct timespec ts = {0, 10 * 1000 * 1000};
+    int sig = sigtimedwait(&set, nullptr, &ts);
+    if (sig == SIGTERM || sig == SIGINT) break;
+    if (sig == SIGHUP) Log(LogLevel::kNotice, "SIGHUP ignored: restart ccommd to load a new configuration");
+    uint64_t now = platform::MonotonicNs();
+    daemon.Supervise(now);
+    // Ping the watchdog only while both I/O loops make progress.
+    if (watchdog_ns && now - last_ping >= watchdog_ns / 2) {
+      uint64_t t = daemon.tx_loops(), x = daemon.rx_loops();
+      if (t != last_tx && x != last_rx) sd::NotifyWatchdog();
+      last_tx = t;
+      last_rx = x;
+      last_ping = now;
+    }
+  }
+  if (ccomm_steady_state_end) ccomm_steady_state_end();
+  sd::NotifyStopping();
+  Log(LogLevel::kInfo, "stopping");
+  daemon.RequestStop();
+  pthread_join(tx, nullptr);
+  pthread_join(rx, nullptr);
+  daemon.Shutdown();
+  return 0;
+}

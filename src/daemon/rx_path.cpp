@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: Apache-2.0
+// Receive path: validate a frame completely, account it to its peer, store its entries.
+// Anything malformed or unexpected is counted and dropped; nothing is half-applied.
+#include <errno.h>
+#include <time.h>
+
+#include "common/platform.h"
+#include "daemon/daemon.h"
+
+namespace ccomm {
+
+void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
+  wire::FrameHeader h;
+  if (wire::DecodeHeader(buf, len, &h) != wire::DecodeError::kOk) {
+    Count(store::kFramesBad);
+    return;
+  }
+  if (h.config_hash != cfg_->hash) {
+    Count(store::kFramesWrongHash);
+    return;
+  }
+  if (h.sender >= peers_rx_.size() || h.sender == self_ || !peers_tx_[h.sender].active) {
+    Count(store::kFramesUnknownSender);
+    return;
+  }
+  if (h.dest != self_ && h.dest != wire::kDestAll) {
+    Count(store::kFramesNotForUs);  // a broadcast frame meant for another node
+    return;
+  }
+  Count(store::kFramesRx);
+
+  store::PeerStats& ps = segment_.peer(h.sender);
+  PeerRx& pr = peers_rx_[h.sender];
+  uint32_t ahead = h.seq - pr.expected;  // modulo 2^32
+  if (!pr.seen || ahead == 0) {
+    pr.seen = true;
+    pr.expected = h.seq + 1;
+  } else if (ahead < 0x80000000u) {
+    ps.frames_lost.fetch_add(ahead, std::memory_order_relaxed);
+    pr.expected = h.seq + 1;
+  } else if (pr.expected - h.seq > 1024) {
+    // Far behind: the peer restarted. Its value sequence numbers may restart too.
+    Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)",
+        cfg_->nodes[h.sender].name.c_str(), h.seq, pr.expected);
+    for (size_t i = 0; i < last_rx_seq_.size(); ++i)
+      if (cfg_->signals[i].producer == h.sender) last_rx_seq_[i] = 0;
+    pr.expected = h.seq + 1;
+  } else {
+    ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
+  }
+  ps.frames_rx.fetch_add(1, std::memory_order_relaxed);
+  ps.last_seq.store(h.seq, std::memory_order_relaxed);
+  ps.last_rx_ns.store(now, std::memory_order_release);
+  ps.last_latency_ns.store(now - h.send_time_ns, std::memory_order_relaxed);
+  if (!ps.alive.exchange(1, std::memory_order_acq_rel))
+    Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
+  if (h.flags & wire::kFlagHeartbeat) ps.heartbeats_rx.fetch_add(1, std::memory_order_relaxed);
+
+  wire::EntryIterator it(buf, h);
+  wire::EntryView e;
+  bool stored = false;
+  while (it.Next(&e)) {
+    if (e.signal >= segment_.signal_count()) {
+      Count(store::kEntriesUnknownSignal);
+      continue;
+    }
+    const store::SignalDirectoryEntry& d = segment_.dir(e.signal);
+    const SignalConfig& sc = cfg_->signals[e.signal];
+    if (!(d.flags & store::kSigConsumedHere) || sc.producer != h.sender) {
+      Count(store::kFramesNotForUs);
+      continue;
+    }
+    bool is_event = (d.flags & store::kSigEvent) != 0;
+    if (e.type != d.type || e.count != d.count || e.value_len != d.value_bytes ||
+        ((e.flags & wire::kEntryEvent) != 0) != is_event) {
+      Count(store::kEntriesWrongType);
+      continue;
+    }
+    uint64_t& last = last_rx_seq_[e.signal];
+    if (last && e.seq <= last) continue;  // duplicate or older than what we have
+    store::SignalStats& ss = segment_.stats(e.signal);
+    // Gaps mean lost values only where every value is sent (events, event-driven states).
+    if (last && e.seq > last + 1 && (is_event || sc.period_us == 0))
+      ss.lost.fetch_add(e.seq - last - 1, std::memory_order_relaxed);
+    last = e.seq;
+    wire::ValueToHost(e.type, e.value, rx_value_, e.count);
+    store::StoreResult r =
+        is_event ? store::RingWrite(segment_.ring(e.signal), rx_value_, e.seq, e.source_time_ns, now)
+                 : store::StateWrite(segment_.state(e.signal), rx_value_, e.seq, e.source_time_ns, now);
+    if (r != store::StoreResult::kOk) {
+      ss.write_errors.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    ss.rx.fetch_add(1, std::memory_order_relaxed);
+    ss.last_rx_ns.store(now, std::memory_order_relaxed);
+    stored = true;
+  }
+  if (stored) segment_.NotifyRx();
+}
+
+void Daemon::RunRx() {
+  const NodeConfig& self = cfg_->nodes[self_];
+  if (!opt_.no_realtime) {
+    if (self.realtime.priority > 0 && platform::SetFifoPriority(self.realtime.priority) != 0)
+      Log(LogLevel::kWarning, "receive thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE); running SCHED_OTHER",
+          self.realtime.priority);
+    if (self.realtime.cpu >= 0) platform::PinToCpu(self.realtime.cpu);
+  }
+  platform::PrefaultStack(32 * 1024);
+  while (running_.load(std::memory_order_relaxed)) {
+    rx_loops_.fetch_add(1, std::memory_order_relaxed);
+    PeerAddress from;
+    ssize_t n = transport_.Recv(rx_buf_, sizeof rx_buf_, &from);
+    if (n > 0) {
+      HandleFrame(rx_buf_, static_cast<size_t>(n), platform::MonotonicNs());
+    } else if (n < 0) {
+      if (n == -EMSGSIZE) Count(store::kFramesBad);
+      else Count(store::kRecvErrors);
+      if (n != -EMSGSIZE) {
+        // e.g. ENETDOWN while the link is down: do not spin.
+        struct timespec ts = {0, 10 * 1000 * 1000};
+        nanosleep(&ts, nullptr);
+      }
+    }
+  }
+}
+
+}  // namespace ccomm

@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: Apache-2.0
+// One transport per file behind a short function table (LCM style): raw Ethernet
+// (transport_raw.cpp) and UDP (transport_udp.cpp). ccommd opens one at start-up; send
+// and recv are the only calls on its real-time paths and never allocate.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "config/config.h"
+
+namespace ccomm {
+
+/// Where a frame goes (or came from). Raw: mac; UDP: ipv4 + port (network order).
+struct PeerAddress {
+  uint8_t mac[6] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff};
+  uint32_t ipv4 = 0;
+  uint16_t port = 0;
+};
+
+struct Transport;
+
+struct TransportOps {
+  const char* name;
+  /// Sends one frame; 0 or -errno. Never blocks for long (socket send buffer).
+  int (*send)(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len);
+  /// Waits up to the transport's receive timeout for one frame. Returns its length,
+  /// 0 on timeout, or -errno. `from` is filled when a frame is returned.
+  ssize_t (*recv)(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from);
+  void (*close)(Transport* t);
+};
+
+struct Transport {
+  const TransportOps* ops = nullptr;
+  int fd = -1;
+  int ifindex = 0;
+  uint16_t ethertype = 0;  // raw
+  uint16_t port = 0;       // UDP, network order
+  uint8_t own_mac[6] = {};
+
+  int Send(const PeerAddress& to, const uint8_t* f, size_t n) { return ops->send(this, to, f, n); }
+  ssize_t Recv(uint8_t* b, size_t cap, PeerAddress* from) { return ops->recv(this, b, cap, from); }
+  void Close() {
+    if (ops) ops->close(this);
+    ops = nullptr;
+  }
+};
+
+/// Opens the transport `self` is configured for. `recv_timeout_ms` bounds Recv so the
+/// receive thread can notice shutdown. Returns 0, or -errno with a message in `error`
+/// that says what to do (e.g. missing CAP_NET_RAW).
+int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
+                     Transport* out, std::string* error);
+int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
+                     Transport* out, std::string* error);
+
+/// Address of `peer` for `t`'s kind (broadcast MAC when the peer has none; its
+/// multicast group or unicast IP for UDP). False if the peer cannot be reached.
+bool PeerAddressFor(const NetworkConfig& net, const NodeConfig& peer, TransportKind kind,
+                    PeerAddress* out);
+
+}  // namespace ccomm

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: Apache-2.0
+// Raw Ethernet: AF_PACKET/SOCK_DGRAM on one interface, filtered by EtherType in the
+// kernel. The kernel builds the Ethernet header from the destination MAC.
+#include <arpa/inet.h>
+#include <errno.h>
+#include <linux/if_packet.h>
+#include <net/ethernet.h>
+#include <net/if.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "daemon/transport.h"
+#include "wire/wire.h"
+
+namespace ccomm {
+namespace {
+
+int RawSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
+  struct sockaddr_ll sll;
+  memset(&sll, 0, sizeof sll);
+  sll.sll_family = AF_PACKET;
+  sll.sll_ifindex = t->ifindex;
+  sll.sll_protocol = htons(t->ethertype);
+  sll.sll_halen = 6;
+  memcpy(sll.sll_addr, to.mac, 6);
+  ssize_t n = sendto(t->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll);
+  return n == static_cast<ssize_t>(len) ? 0 : -errno;
+}
+
+ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
+  for (;;) {
+    struct sockaddr_ll sll;
+    socklen_t sl = sizeof sll;
+    ssize_t n = recvfrom(t->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sll), &sl);
+    if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -errno;
+    if (sll.sll_pkttype == PACKET_OUTGOING) continue;  // our own frames, looped back
+    if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
+    memcpy(from->mac, sll.sll_addr, 6);
+    // Ethernet pads payloads to 46 bytes: trim padding after the declared frame length.
+    if (n >= static_cast<ssize_t>(wire::kHeaderSize) && n <= 46) {
+      size_t declared = wire::kHeaderSize + ((size_t{buf[26]} << 8) | buf[27]) +
+                        ((buf[5] & wire::kFlagAuth) ? wire::kAuthTagSize : 0);
+      if (declared < static_cast<size_t>(n)) n = static_cast<ssize_t>(declared);
+    }
+    return n;
+  }
+}
+
+void RawClose(Transport* t) {
+  if (t->fd >= 0) close(t->fd);
+  t->fd = -1;
+}
+
+const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawClose};
+
+}  // namespace
+
+int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
+                     Transport* out, std::string* error) {
+  int fd = socket(AF_PACKET, SOCK_DGRAM | SOCK_CLOEXEC, htons(net.ethertype));
+  if (fd < 0) {
+    int e = errno;
+    *error = std::string("cannot open a raw packet socket: ") + strerror(e);
+    if (e == EPERM || e == EACCES)
+      *error += " (raw Ethernet needs CAP_NET_RAW: run ccommd as root or with that capability, "
+                "or use transport=\"udp\" / ccommd --transport udp)";
+    return -e;
+  }
+  unsigned ifindex = if_nametoindex(self.interface.c_str());
+  if (ifindex == 0) {
+    *error = "no network interface '" + self.interface + "' (node '" + self.name + "')";
+    close(fd);
+    return -ENODEV;
+  }
+  struct sockaddr_ll sll;
+  memset(&sll, 0, sizeof sll);
+  sll.sll_family = AF_PACKET;
+  sll.sll_protocol = htons(net.ethertype);
+  sll.sll_ifindex = static_cast<int>(ifindex);
+  if (bind(fd, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll) != 0) {
+    int e = errno;
+    *error = "cannot bind raw socket to " + self.interface + ": " + strerror(e);
+    close(fd);
+    return -e;
+  }
+  int one = 1;
+#ifdef PACKET_IGNORE_OUTGOING
+  setsockopt(fd, SOL_PACKET, PACKET_IGNORE_OUTGOING, &one, sizeof one);
+#endif
+  (void)one;
+  struct timeval tv = {recv_timeout_ms / 1000, (recv_timeout_ms % 1000) * 1000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  struct ifreq ifr;
+  memset(&ifr, 0, sizeof ifr);
+  snprintf(ifr.ifr_name, IFNAMSIZ, "%s", self.interface.c_str());
+  if (ioctl(fd, SIOCGIFHWADDR, &ifr) == 0) memcpy(out->own_mac, ifr.ifr_hwaddr.sa_data, 6);
+  out->ops = &kRawOps;
+  out->fd = fd;
+  out->ifindex = static_cast<int>(ifindex);
+  out->ethertype = net.ethertype;
+  return 0;
+}
+
+}  // namespace ccomm

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: Apache-2.0
+// Send path: woken at once by a client's doorbell (event-driven signals), or at the
+// next periodic/heartbeat deadline; batches everything due for one peer into one frame.
+#include <errno.h>
+#include <string.h>
+
+#include "common/platform.h"
+#include "daemon/daemon.h"
+
+namespace ccomm {
+
+void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
+  PeerTx& p = peers_tx_[peer];
+  wire::FrameHeader h;
+  h.flags = flags;
+  h.sender = static_cast<uint16_t>(self_);
+  h.dest = static_cast<uint16_t>(peer);
+  h.config_hash = cfg_->hash;
+  h.seq = p.seq++;
+  h.send_time_ns = now;
+  p.writer.Begin(h);
+  p.open = true;
+}
+
+void Daemon::FlushPeer(uint32_t peer) {
+  PeerTx& p = peers_tx_[peer];
+  if (!p.open) return;
+  size_t len = p.writer.Finish();
+  int r = transport_.Send(p.addr, p.buf, len);
+  p.open = false;
+  p.last_tx_ns = platform::MonotonicNs();  // also on failure: a dead link must not busy-loop
+  if (r != 0) {
+    Count(store::kSendErrors);
+    return;
+  }
+  Count(store::kFramesTx);
+  segment_.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
+}
+
+void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
+                      const store::SlotMeta& m, const void* value, uint64_t now) {
+  for (uint32_t peer : consumers_[id]) {
+    PeerTx& p = peers_tx_[peer];
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      if (!p.open) BeginFrame(peer, now, 0);
+      if (p.writer.Add(static_cast<uint16_t>(id), d.type, flags, static_cast<uint16_t>(d.count),
+                       static_cast<uint32_t>(m.value_seq), m.source_time_ns, value, d.value_bytes))
+        break;
+      FlushPeer(peer);  // full: send what we have and start a new frame
+    }
+  }
+  segment_.stats(id).tx.fetch_add(1, std::memory_order_relaxed);
+}
+
+void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
+  const store::SignalDirectoryEntry& d = segment_.dir(id);
+  store::SlotMeta m;
+  if (d.flags & store::kSigEvent) {
+    store::RingView ring = segment_.ring(id);
+    store::RingCursor& cur = fwd_cursors_[id];
+    for (uint32_t i = 0; i < d.queue_depth; ++i) {  // bounded: at most one ring's worth
+      if (store::RingRead(ring, &cur, tx_value_, &m, now) != store::StoreResult::kOk) break;
+      AddEntry(id, d, wire::kEntryEvent, m, tx_value_, now);
+    }
+    ring.ring->fwd_cursor.store(cur.next, std::memory_order_release);
+    return;
+  }
+  store::StateView sv = segment_.state(id);
+  uint64_t version = store::StateVersion(sv);
+  // Event-driven: send each new value once. Periodic: send the last value every period.
+  if (version == 0 || (!periodic && version == sv.cell->forwarded.load(std::memory_order_relaxed))) return;
+  if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) return;
+  sv.cell->forwarded.store(version, std::memory_order_relaxed);
+  AddEntry(id, d, 0, m, tx_value_, now);
+}
+
+void Daemon::RunTx() {
+  const NodeConfig& self = cfg_->nodes[self_];
+  if (!opt_.no_realtime) {
+    if (self.realtime.priority > 0 && platform::SetFifoPriority(self.realtime.priority) != 0)
+      Log(LogLevel::kWarning, "send thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE); running SCHED_OTHER",
+          self.realtime.priority);
+    if (self.realtime.cpu >= 0) platform::PinToCpu(self.realtime.cpu);
+  }
+  platform::PrefaultStack(32 * 1024);
+  store::SegmentHeader* h = segment_.header();
+  std::atomic<uint64_t>* dirty = segment_.dirty_words();
+  const uint32_t words = (segment_.signal_count() + 63) / 64;
+  const uint64_t spin_ns = uint64_t{self.realtime.spin_us} * 1000;
+
+  while (running_.load(std::memory_order_relaxed)) {
+    tx_loops_.fetch_add(1, std::memory_order_relaxed);
+    uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
+    uint64_t now = platform::MonotonicNs();
+    for (uint32_t w = 0; w < words; ++w) {
+      uint64_t bits = dirty[w].exchange(0, std::memory_order_acq_rel);
+      while (bits) {
+        uint32_t b = static_cast<uint32_t>(__builtin_ctzll(bits));
+        bits &= bits - 1;
+        uint32_t id = w * 64 + b;
+        if (id < segment_.signal_count() && !consumers_[id].empty()) CollectSignal(id, now, false);
+      }
+    }
+    uint64_t next_deadline = now + heartbeat_ns_;
+    for (uint32_t id : periodic_) {
+      if (now >= due_ns_[id]) {
+        CollectSignal(id, now, true);
+        uint64_t period = uint64_t{cfg_->signals[id].period_us} * 1000;
+        due_ns_[id] += period;
+        if (due_ns_[id] <= now) due_ns_[id] = now + period;  // fell behind: do not burst
+      }
+      if (due_ns_[id] < next_deadline) next_deadline = due_ns_[id];
+    }
+    for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
+      PeerTx& pt = peers_tx_[p];
+      if (!pt.active) continue;
+      if (pt.open) {
+        FlushPeer(p);
+      } else if (now - pt.last_tx_ns >= heartbeat_ns_) {
+        BeginFrame(p, now, wire::kFlagHeartbeat);
+        FlushPeer(p);
+      }
+      uint64_t hb_due = pt.last_tx_ns + heartbeat_ns_;
+      if (hb_due < next_deadline) next_deadline = hb_due;
+    }
+
+    // Optional busy-poll window (no syscalls) before sleeping: trades CPU for latency.
+    if (spin_ns) {
+      uint64_t until = platform::MonotonicNs() + spin_ns;
+      while (h->tx_doorbell.load(std::memory_order_acquire) == snapshot && platform::MonotonicNs() < until &&
+             platform::MonotonicNs() < next_deadline) {
+        platform::CpuRelax();
+      }
+      if (h->tx_doorbell.load(std::memory_order_acquire) != snapshot) continue;
+    }
+    now = platform::MonotonicNs();
+    if (next_deadline <= now) continue;
+    h->tx_sleeping.store(1, std::memory_order_seq_cst);
+    platform::FutexWait(&h->tx_doorbell, snapshot, static_cast<int64_t>(next_deadline - now));
+    h->tx_sleeping.store(0, std::memory_order_relaxed);
+    Count(store::kTxWakeups);
+  }
+}
+
+}  // namespace ccomm

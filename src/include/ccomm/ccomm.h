@@ -1,0 +1,153 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/*
+ * ccomm C API: read and write named signals of the local node through shared memory.
+ *
+ * Made for generated controller code (20-sim, Simulink) and hand-written loops:
+ *   - ccomm_open / ccomm_find / ccomm_close are start-up and shutdown calls (they
+ *     allocate, make syscalls and may fail).
+ *   - ccomm_read* and ccomm_write* are real-time safe: lock-free, wait-free in practice
+ *     (bounded retries), no allocation, no blocking, no syscall -- except that a write
+ *     of a signal forwarded event-driven by ccommd rings a doorbell (one non-blocking
+ *     FUTEX_WAKE) when the daemon is asleep. Open with CCOMM_OPEN_NO_DOORBELL to make
+ *     writes syscall-free (e.g. a Xenomai primary-mode thread); ccommd then sends at its
+ *     periodic cycle or heartbeat instead of at once.
+ *   - ccomm_wait blocks and is meant for non-real-time consumers.
+ * Every read says whether the value is fresh, stale or was never received.
+ * A handle is used by one thread at a time (event cursors live in it); open one handle
+ * per thread. Several processes and handles may use the same signals concurrently.
+ */
+#ifndef CCOMM_CCOMM_H
+#define CCOMM_CCOMM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CCOMM_API_VERSION 1
+
+#if defined(__GNUC__)
+#define CCOMM_API __attribute__((visibility("default")))
+#else
+#define CCOMM_API
+#endif
+
+/** Read status (>= 0). */
+typedef enum ccomm_status {
+  CCOMM_FRESH = 0, /**< value younger than the signal's stale_after_ms */
+  CCOMM_STALE = 1, /**< value older than stale_after_ms (or the safe value, see flags) */
+  CCOMM_NEVER = 2, /**< nothing received since the node's segment was created */
+  CCOMM_EMPTY = 3  /**< event signal: no new event since the last read */
+} ccomm_status;
+
+/** Errors (< 0). ccomm_strerror() names them. */
+#define CCOMM_E_INVAL (-1)   /**< bad argument: NULL, unknown signal handle, wrong length */
+#define CCOMM_E_NOENT (-2)   /**< no such signal, or no segment: is ccommd running? */
+#define CCOMM_E_TYPE (-3)    /**< typed call does not match the signal's type/count */
+#define CCOMM_E_PERM (-4)    /**< this node is not the signal's producer */
+#define CCOMM_E_FULL (-5)    /**< event queue full: ccommd is not forwarding; event not queued */
+#define CCOMM_E_BUSY (-6)    /**< writers raced for every slot; retry next cycle */
+#define CCOMM_E_SYS (-7)     /**< an OS call failed at open; errno says why */
+#define CCOMM_E_VERSION (-8) /**< segment has another layout version than this library */
+#define CCOMM_E_RETIRED (-9) /**< ccommd replaced the segment (new config): close and reopen */
+
+/** ccomm_info.flags */
+#define CCOMM_INFO_SAFE_VALUE 0x1u /**< the value returned is the configured safe value */
+
+/** ccomm_open flags */
+#define CCOMM_OPEN_NO_DOORBELL 0x1u /**< writes never make a syscall (see above) */
+
+typedef struct ccomm_client ccomm_client;
+/** A signal handle (its id, the position in signals.xml); < 0 is invalid. */
+typedef int32_t ccomm_signal;
+
+/** What a read returns besides the value. */
+typedef struct ccomm_info {
+  int32_t status;          /**< ccomm_status of this read */
+  uint32_t flags;          /**< CCOMM_INFO_* */
+  uint64_t seq;            /**< producer's sequence number of the value (0 = never) */
+  int64_t age_ns;          /**< time since the value reached this node; -1 if never */
+  uint64_t source_time_ns; /**< producer's CLOCK_MONOTONIC when it wrote the value */
+  uint64_t lost;           /**< values/events of this signal known lost so far (this handle's
+                                overruns plus gaps seen by ccommd) */
+} ccomm_info;
+
+typedef enum ccomm_type {
+  CCOMM_BOOL = 1, CCOMM_INT32 = 2, CCOMM_UINT32 = 3, CCOMM_INT64 = 4, CCOMM_FLOAT = 5, CCOMM_DOUBLE = 6
+} ccomm_type;
+
+/** Static description of a signal. */
+typedef struct ccomm_signal_desc {
+  const char* name;        /**< points into the segment; valid until ccomm_close */
+  int32_t type;            /**< ccomm_type */
+  uint32_t count;          /**< array length (1 = scalar) */
+  uint32_t value_bytes;    /**< count * element size: the length read/write expect */
+  int32_t is_event;        /**< 1 = event (queued), 0 = state (last value wins) */
+  int32_t produced_here;   /**< 1 if this node may write it */
+  uint32_t stale_after_ms; /**< 0 = never stale */
+  const char* producer;    /**< producer node name */
+} ccomm_signal_desc;
+
+/**
+ * Attaches to the shared-memory segment of `node` (NULL: $CCOMM_NODE, else the
+ * hostname). The segment is created by ccommd; returns CCOMM_E_NOENT if it does not
+ * exist. Not real-time safe.
+ */
+CCOMM_API int ccomm_open(const char* node, uint32_t flags, ccomm_client** out);
+/** Detaches; the handle is freed. Not real-time safe. */
+CCOMM_API void ccomm_close(ccomm_client* c);
+/** Name of an error or status code. */
+CCOMM_API const char* ccomm_strerror(int code);
+
+/** Signal handle by name, or CCOMM_E_NOENT. Do this at start-up, not in the loop. */
+CCOMM_API ccomm_signal ccomm_find(ccomm_client* c, const char* name);
+/** Number of signals in the system (ids are 0..n-1). */
+CCOMM_API int ccomm_signal_count(const ccomm_client* c);
+/** Describes a signal; CCOMM_E_INVAL for a bad handle. */
+CCOMM_API int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out);
+/** Name of the node this handle is attached to. */
+CCOMM_API const char* ccomm_node_name(const ccomm_client* c);
+
+/**
+ * Reads a signal. `len` must equal the signal's value_bytes. State signals: copies the
+ * last value (or the safe value when stale, if configured). Event signals: pops the
+ * next event for this handle, or returns CCOMM_EMPTY. Returns a ccomm_status (>= 0) or
+ * an error (< 0); `info` may be NULL. Real-time safe.
+ */
+CCOMM_API int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_info* info);
+/**
+ * Writes a signal produced by this node; `len` must equal value_bytes. Returns 0 or an
+ * error; nothing is half-written. Real-time safe (see the doorbell note above).
+ */
+CCOMM_API int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len);
+
+/* Typed scalar shortcuts: CCOMM_E_TYPE if the signal is not a scalar of that type. */
+CCOMM_API int ccomm_read_double(ccomm_client* c, ccomm_signal s, double* v, ccomm_info* info);
+CCOMM_API int ccomm_write_double(ccomm_client* c, ccomm_signal s, double v);
+CCOMM_API int ccomm_read_float(ccomm_client* c, ccomm_signal s, float* v, ccomm_info* info);
+CCOMM_API int ccomm_write_float(ccomm_client* c, ccomm_signal s, float v);
+CCOMM_API int ccomm_read_int32(ccomm_client* c, ccomm_signal s, int32_t* v, ccomm_info* info);
+CCOMM_API int ccomm_write_int32(ccomm_client* c, ccomm_signal s, int32_t v);
+CCOMM_API int ccomm_read_uint32(ccomm_client* c, ccomm_signal s, uint32_t* v, ccomm_info* info);
+CCOMM_API int ccomm_write_uint32(ccomm_client* c, ccomm_signal s, uint32_t v);
+CCOMM_API int ccomm_read_int64(ccomm_client* c, ccomm_signal s, int64_t* v, ccomm_info* info);
+CCOMM_API int ccomm_write_int64(ccomm_client* c, ccomm_signal s, int64_t v);
+CCOMM_API int ccomm_read_bool(ccomm_client* c, ccomm_signal s, int* v, ccomm_info* info);
+CCOMM_API int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v);
+
+/**
+ * Blocks until any signal of this node changes (a value arrives from the network or a
+ * local write) or `timeout_ms` passes (< 0: forever). Returns 1 if woken by a change,
+ * 0 on timeout. For non-real-time consumers; a control loop just reads each cycle.
+ */
+CCOMM_API int ccomm_wait(ccomm_client* c, int timeout_ms);
+
+/** 1 if ccommd updated its heartbeat in the segment within the last second, else 0. */
+CCOMM_API int ccomm_daemon_alive(const ccomm_client* c);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CCOMM_CCOMM_H */

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: Apache-2.0
+// Layout of a node's shared-memory segment ("/ccomm.<node>").
+//
+// ccommd creates the segment from signals.xml; applications only map it and find
+// everything they need inside (names, types, offsets), so they never parse XML.
+// Invariants:
+//   - No pointers inside the segment: every reference is a byte offset from its start,
+//     so each process may map it at a different address.
+//   - Everything after `state == kReady` is either immutable (header fields, directory,
+//     safe values) or accessed only through std::atomic (slots, rings, counters). Hence
+//     no torn reads, and TSan sees no plain data race.
+//   - Nothing is ever locked: a process killed at any instruction leaves at most one
+//     slot marked "being written", which the algorithms skip (state_slot.h,
+//     event_ring.h).
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+
+namespace ccomm {
+namespace store {
+
+static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
+static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
+
+constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
+constexpr uint32_t kLayoutVersion = 1;
+constexpr size_t kCacheLine = 64;
+constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
+constexpr size_t kNameBytes = 64;
+
+enum SegmentState : uint32_t { kInitializing = 0, kReady = 1, kRetired = 2 };
+
+struct alignas(kCacheLine) SegmentHeader {
+  uint32_t magic;
+  uint32_t layout_version;
+  uint64_t size;               // bytes of the whole segment
+  uint32_t config_hash;
+  uint32_t node_id;
+  uint32_t signal_count;
+  uint32_t node_count;
+  uint64_t directory_offset;   // SignalDirectoryEntry[signal_count]
+  uint64_t node_names_offset;  // char[kNameBytes][node_count]
+  uint64_t signal_stats_offset;  // SignalStats[signal_count]
+  uint64_t peer_stats_offset;    // PeerStats[node_count]
+  uint64_t dirty_offset;         // atomic<uint64_t>[(signal_count + 63) / 64]
+  char node_name[kNameBytes];
+  std::atomic<uint32_t> state;       // SegmentState
+  std::atomic<uint32_t> generation;  // +1 each time a ccommd attaches
+  std::atomic<int32_t> daemon_pid;   // 0 when no daemon
+  std::atomic<uint64_t> daemon_heartbeat_ns;  // ccommd's CLOCK_MONOTONIC, every 100 ms
+
+  // Send path doorbell: writers of forwarded signals set their dirty bit, bump
+  // tx_doorbell and FUTEX_WAKE it only if ccommd said it is about to sleep.
+  alignas(kCacheLine) std::atomic<uint32_t> tx_doorbell;
+  std::atomic<uint32_t> tx_sleeping;
+  // Receive-side notification for ccomm_wait(): bumped on every store update; woken
+  // only when someone waits.
+  alignas(kCacheLine) std::atomic<uint32_t> rx_doorbell;
+  std::atomic<uint32_t> rx_waiters;
+
+  // Daemon-wide counters (frames rejected by reason etc.), see DaemonStats.
+  alignas(kCacheLine) std::atomic<uint64_t> daemon_counters[16];
+};
+
+enum DaemonCounter : uint32_t {
+  kFramesRx = 0, kFramesTx, kFramesBad, kFramesWrongHash, kFramesUnknownSender,
+  kFramesAuthFailed, kFramesReplayed, kFramesNotForUs, kEntriesUnknownSignal,
+  kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kDaemonCounterCount
+};
+
+enum SignalFlags : uint32_t {
+  kSigEvent = 1u << 0,         // event signal (ring) rather than state (slots)
+  kSigProducedHere = 1u << 1,  // this node may write it
+  kSigForwarded = 1u << 2,     // produced here and consumed by another node
+  kSigConsumedHere = 1u << 3,  // produced elsewhere and consumed here
+  kSigHasSafeValue = 1u << 4,
+  kSigPeriodic = 1u << 5,      // forwarded on a period, not on every write
+};
+
+// Immutable after creation.
+struct alignas(8) SignalDirectoryEntry {
+  char name[kNameBytes];
+  uint32_t id;
+  uint32_t flags;          // SignalFlags
+  uint8_t type;            // ValueType code
+  uint8_t reserved[3];
+  uint32_t count;
+  uint32_t value_bytes;    // count * element size
+  uint32_t slot_bytes;     // bytes of one slot including its header, multiple of 8
+  uint32_t producer;       // node id
+  uint32_t stale_after_ms;
+  uint32_t period_us;
+  uint32_t queue_depth;    // events: ring capacity (power of two); states: kStateSlots
+  uint64_t data_offset;    // StateCell or EventRing
+  uint64_t safe_value_offset;  // value_bytes, rounded to 8; 0 if none
+};
+
+// Header of every slot (state copy or event), followed by the value rounded up to 8 bytes.
+// `seq` protocol (ticket t): 2t+1 while being written, 2t+2 when complete, 0 = never.
+struct alignas(8) SlotHeader {
+  std::atomic<uint64_t> seq;
+  std::atomic<uint64_t> value_seq;       // producer's sequence number of the value
+  std::atomic<uint64_t> source_time_ns;  // producer's clock at write
+  std::atomic<uint64_t> local_time_ns;   // this node's clock when it entered the segment
+};
+static_assert(sizeof(SlotHeader) == 32, "slot header is 4 words");
+
+struct alignas(kCacheLine) StateCell {
+  std::atomic<uint64_t> next_ticket;  // claimed tickets
+  std::atomic<uint64_t> latest;       // ticket + 1 of the newest complete copy; 0 = never
+  std::atomic<uint64_t> forwarded;    // `latest` value ccommd last sent (send-side bookkeeping)
+  // followed (at the next cache line) by kStateSlots slots of slot_bytes each
+};
+
+struct alignas(kCacheLine) EventRing {
+  std::atomic<uint64_t> head;        // next ticket to claim
+  std::atomic<uint64_t> fwd_cursor;  // next ticket ccommd will forward (forwarded signals)
+  // followed (at the next cache line) by queue_depth slots of slot_bytes each
+};
+
+struct alignas(kCacheLine) SignalStats {
+  std::atomic<uint64_t> writes;       // local writes accepted
+  std::atomic<uint64_t> write_errors; // local writes refused (full, busy)
+  std::atomic<uint64_t> tx;           // values sent by ccommd
+  std::atomic<uint64_t> rx;           // values received by ccommd
+  std::atomic<uint64_t> lost;         // gaps in the producer's sequence seen by ccommd
+  std::atomic<uint64_t> overflow;     // events a reader lost to ring overrun (all readers)
+  std::atomic<uint64_t> stale_transitions;  // fresh -> stale seen by ccommd's supervision
+  std::atomic<uint64_t> last_rx_ns;
+};
+
+struct alignas(kCacheLine) PeerStats {
+  std::atomic<uint64_t> frames_rx;
+  std::atomic<uint64_t> frames_tx;
+  std::atomic<uint64_t> frames_lost;      // gaps in the peer's frame sequence
+  std::atomic<uint64_t> frames_reordered; // older than expected (duplicates, reordering)
+  std::atomic<uint64_t> heartbeats_rx;
+  std::atomic<uint64_t> last_rx_ns;
+  std::atomic<uint64_t> down_transitions; // alive -> lost
+  std::atomic<uint32_t> alive;            // 1 while heartbeats arrive within peer_timeout_ms
+  std::atomic<uint32_t> last_seq;
+  std::atomic<uint64_t> last_latency_ns;  // last frame's (arrival - send time); same-clock setups only
+};
+
+inline constexpr size_t AlignUp(size_t v, size_t a) { return (v + a - 1) & ~(a - 1); }
+
+template <typename T>
+inline T* At(void* base, uint64_t offset) {
+  return reinterpret_cast<T*>(static_cast<char*>(base) + offset);
+}
+template <typename T>
+inline const T* At(const void* base, uint64_t offset) {
+  return reinterpret_cast<const T*>(static_cast<const char*>(base) + offset);
+}
+
+}  // namespace store
+}  // namespace ccomm

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: Apache-2.0
+// A node's shared-memory segment: created (or re-adopted) by ccommd from the
+// configuration, mapped by clients. See layout.h for the invariants.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "config/config.h"
+#include "store/event_ring.h"
+#include "store/layout.h"
+#include "store/state_slot.h"
+
+namespace ccomm {
+namespace store {
+
+/// POSIX shm name of a node's segment: $CCOMM_SHM_PREFIX (default "/ccomm.") + node.
+std::string SegmentName(const std::string& node);
+
+class Segment {
+ public:
+  Segment() = default;
+  ~Segment() { Close(); }
+  Segment(const Segment&) = delete;
+  Segment& operator=(const Segment&) = delete;
+
+  /// Daemon side. Re-adopts an existing segment with exactly the layout this
+  /// configuration produces (clients keep running across a daemon restart); otherwise
+  /// marks the old one retired, unlinks it and creates a fresh one (mode 0660, group
+  /// `gid` if >= 0). Returns 0 or -errno; `error` says what failed.
+  int CreateOrAdopt(const SystemConfig& cfg, uint32_t node_id, const std::string& name,
+                    int gid, bool* adopted, std::string* error);
+
+  /// Client side: maps an existing, ready segment. Returns 0, -ENOENT (no segment or
+  /// not ready yet), -EPROTO (bad magic/layout version/size) or another -errno.
+  int Open(const std::string& name);
+
+  void Close();
+  bool is_open() const { return base_ != nullptr; }
+
+  SegmentHeader* header() const { return static_cast<SegmentHeader*>(base_); }
+  uint32_t signal_count() const { return header()->signal_count; }
+  uint32_t node_count() const { return header()->node_count; }
+  const SignalDirectoryEntry& dir(uint32_t id) const {
+    return At<SignalDirectoryEntry>(base_, header()->directory_offset)[id];
+  }
+  const char* node_name(uint32_t node) const {
+    return At<char>(base_, header()->node_names_offset) + node * kNameBytes;
+  }
+  SignalStats& stats(uint32_t id) const {
+    return At<SignalStats>(base_, header()->signal_stats_offset)[id];
+  }
+  PeerStats& peer(uint32_t node) const {
+    return At<PeerStats>(base_, header()->peer_stats_offset)[node];
+  }
+  std::atomic<uint64_t>* dirty_words() const {
+    return At<std::atomic<uint64_t>>(base_, header()->dirty_offset);
+  }
+  StateView state(uint32_t id) const;
+  RingView ring(uint32_t id) const;
+  const uint8_t* safe_value(uint32_t id) const;
+  /// Signal id by name, or -1 (linear scan: start-up only).
+  int Find(const char* name) const;
+
+  /// Marks a forwarded signal changed and rings ccommd's doorbell (see layout.h).
+  void NotifyTx(uint32_t id, bool ring_doorbell) const;
+  /// Bumps rx_doorbell and wakes ccomm_wait() callers, if any.
+  void NotifyRx() const;
+
+  void* base() const { return base_; }
+  size_t size() const { return size_; }
+
+ private:
+  void* base_ = nullptr;
+  size_t size_ = 0;
+};
+
+/// Builds the complete segment image for `cfg` as seen by `node_id` into `mem`
+/// (size from SegmentSize). Used for creation and to compare with an existing segment.
+size_t SegmentSize(const SystemConfig& cfg);
+void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size);
+
+}  // namespace store
+}  // namespace ccomm

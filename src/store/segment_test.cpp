@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: Apache-2.0
+// Segment creation, client open, adoption across a daemon restart, replacement on a
+// configuration change (old clients see "retired").
+#include "store/segment.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include "common/platform.h"
+#include "store/test_config.h"
+
+namespace ccomm {
+namespace store {
+namespace {
+
+using testing::MakeSignal;
+using testing::TwoNodeConfig;
+
+class SegmentTest : public ::testing::Test {
+ protected:
+  void SetUp() override { setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("seg").c_str(), 1); }
+  void TearDown() override { platform::ShmUnlink(SegmentName("a").c_str()); }
+  SystemConfig Cfg() {
+    auto s1 = MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
+    s1.has_safe_value = true;
+    s1.safe_value.assign(8, 0);
+    auto s2 = MakeSignal("sp", ValueType::kFloat, 3, SignalKind::kState, 1, {0});
+    auto s3 = MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 0, {1});
+    s3.queue_depth = 16;
+    return TwoNodeConfig({s1, s2, s3});
+  }
+};
+
+TEST_F(SegmentTest, CreateThenOpenSeesDirectory) {
+  SystemConfig cfg = Cfg();
+  Segment d;
+  bool adopted = true;
+  std::string err;
+  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+  EXPECT_FALSE(adopted);
+  Segment c;
+  ASSERT_EQ(c.Open(SegmentName("a")), 0);
+  EXPECT_EQ(c.signal_count(), 3u);
+  EXPECT_EQ(c.Find("sp"), 1);
+  EXPECT_EQ(c.Find("nope"), -1);
+  EXPECT_TRUE(c.dir(0).flags & kSigForwarded);
+  EXPECT_TRUE(c.dir(1).flags & kSigConsumedHere);
+  EXPECT_TRUE(c.dir(2).flags & kSigEvent);
+  EXPECT_EQ(c.dir(1).value_bytes, 12u);
+  EXPECT_STREQ(c.node_name(1), "b");
+  EXPECT_NE(c.safe_value(0), nullptr);
+  EXPECT_EQ(c.safe_value(1), nullptr);
+}
+
+TEST_F(SegmentTest, RestartAdoptsAndKeepsValues) {
+  SystemConfig cfg = Cfg();
+  std::string err;
+  bool adopted;
+  Segment client;
+  {
+    Segment d;
+    ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+    ASSERT_EQ(client.Open(SegmentName("a")), 0);
+    double v = 4.25;
+    ASSERT_EQ(StateWrite(client.state(0), &v, 0, 1, 1), StoreResult::kOk);
+  }  // daemon gone
+  Segment d2;
+  ASSERT_EQ(d2.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  EXPECT_TRUE(adopted);
+  EXPECT_EQ(d2.header()->generation.load(), 2u);
+  double out = 0;
+  SlotMeta m;
+  ASSERT_EQ(StateRead(d2.state(0), &out, &m), StoreResult::kOk);
+  EXPECT_EQ(out, 4.25);
+  EXPECT_EQ(client.header()->state.load(), kReady);
+}
+
+TEST_F(SegmentTest, ConfigChangeRetiresOldSegment) {
+  SystemConfig cfg = Cfg();
+  std::string err;
+  bool adopted;
+  Segment d, client;
+  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(client.Open(SegmentName("a")), 0);
+  SystemConfig changed = cfg;
+  changed.signals[1].count = 4;
+  changed.hash += 1;
+  Segment d2;
+  ASSERT_EQ(d2.CreateOrAdopt(changed, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  EXPECT_FALSE(adopted);
+  EXPECT_EQ(client.header()->state.load(), kRetired);
+  Segment fresh;
+  ASSERT_EQ(fresh.Open(SegmentName("a")), 0);
+  EXPECT_EQ(fresh.dir(1).count, 4u);
+}
+
+TEST_F(SegmentTest, OpenMissingOrForeignSegment) {
+  Segment c;
+  EXPECT_EQ(c.Open(SegmentName("a")), -ENOENT);
+  int fd = platform::ShmOpen(SegmentName("a").c_str(), true, 0600);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(platform::Truncate(fd, 4096), 0);
+  platform::CloseFd(fd);
+  EXPECT_EQ(c.Open(SegmentName("a")), -EPROTO);  // zeros: not our magic
+  // The daemon replaces a foreign or half-created segment.
+  Segment d;
+  std::string err;
+  bool adopted;
+  ASSERT_EQ(d.CreateOrAdopt(Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+  EXPECT_EQ(c.Open(SegmentName("a")), 0);
+}
+
+}  // namespace
+}  // namespace store
+}  // namespace ccomm

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: Apache-2.0
+// State signals: the last value wins, many writers and many readers, lock-free.
+//
+// A StateCell owns kStateSlots copies. A writer takes a ticket t (fetch_add), claims
+// slot t % kStateSlots by CAS-ing its seq from an even value to 2t+1, copies the value,
+// stores seq = 2t+2 and raises `latest` to t+1. A reader copies slot (latest-1) and
+// accepts it only if seq == 2(latest-1)+2 before and after the copy (seqlock).
+//
+// Invariants:
+//   - The slot holding `latest` is never claimed: a newer complete copy must exist
+//     before the newest one can be overwritten, so readers always find a valid copy.
+//   - A writer killed mid-copy leaves its slot odd forever; later writers skip odd
+//     slots, readers never look at it (it never became `latest`). Nothing stalls.
+//   - Every loop is bounded; under absurd contention the call reports kBusy instead
+//     of spinning.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "store/layout.h"
+#include "store/word_copy.h"
+
+namespace ccomm {
+namespace store {
+
+struct SlotMeta {
+  uint64_t value_seq = 0;
+  uint64_t source_time_ns = 0;
+  uint64_t local_time_ns = 0;
+};
+
+struct StateView {
+  StateCell* cell = nullptr;
+  uint8_t* slots = nullptr;  // kStateSlots * slot_bytes
+  uint32_t slot_bytes = 0;
+  uint32_t value_bytes = 0;
+
+  SlotHeader* slot(uint64_t ticket) const {
+    return reinterpret_cast<SlotHeader*>(slots + (ticket % kStateSlots) * slot_bytes);
+  }
+};
+
+enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull };
+
+/// Writes a value. value_seq == 0 means "number it": the ticket + 1 is used.
+/// Returns kOk or kBusy. On kOk, *seq_out (if given) is the value's sequence number.
+inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t value_seq,
+                              uint64_t source_time_ns, uint64_t local_time_ns,
+                              uint64_t* seq_out = nullptr) {
+  for (uint32_t attempt = 0; attempt < 2 * kStateSlots; ++attempt) {
+    uint64_t t = v.cell->next_ticket.fetch_add(1, std::memory_order_relaxed);
+    uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
+    if (latest != 0 && (latest - 1) % kStateSlots == t % kStateSlots) continue;  // newest copy
+    SlotHeader* h = v.slot(t);
+    uint64_t s = h->seq.load(std::memory_order_relaxed);
+    if ((s & 1) || s > 2 * t) continue;  // being written (or its writer died), or newer
+    if (!h->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel)) continue;
+    std::atomic_thread_fence(std::memory_order_release);
+    uint64_t vs = value_seq ? value_seq : t + 1;
+    h->value_seq.store(vs, std::memory_order_relaxed);
+    h->source_time_ns.store(source_time_ns, std::memory_order_relaxed);
+    h->local_time_ns.store(local_time_ns, std::memory_order_relaxed);
+    StoreWords(reinterpret_cast<uint8_t*>(h + 1), value, v.value_bytes);
+    h->seq.store(2 * t + 2, std::memory_order_release);
+    // Publish: raise latest to t+1 unless a newer copy is already published. Each
+    // failed CAS means another writer published, so this ends within #writers tries.
+    uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
+    while (cur < t + 1 &&
+           !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_release,
+                                                 std::memory_order_relaxed)) {
+    }
+    if (seq_out) *seq_out = vs;
+    return StoreResult::kOk;
+  }
+  return StoreResult::kBusy;
+}
+
+/// Copies the newest complete value. Returns kOk, kNever (nothing written yet) or
+/// kBusy (writers overtook the reader 16 times in a row).
+inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
+    if (latest == 0) return StoreResult::kNever;
+    uint64_t t = latest - 1;
+    const SlotHeader* h = v.slot(t);
+    uint64_t s1 = h->seq.load(std::memory_order_acquire);
+    if (s1 != 2 * t + 2) continue;
+    meta->value_seq = h->value_seq.load(std::memory_order_relaxed);
+    meta->source_time_ns = h->source_time_ns.load(std::memory_order_relaxed);
+    meta->local_time_ns = h->local_time_ns.load(std::memory_order_relaxed);
+    LoadWords(out, reinterpret_cast<const uint8_t*>(h + 1), v.value_bytes);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (h->seq.load(std::memory_order_relaxed) == s1) return StoreResult::kOk;
+  }
+  return StoreResult::kBusy;
+}
+
+/// `latest` counter: changes whenever a new value is published (cheap change check).
+inline uint64_t StateVersion(const StateView& v) {
+  return v.cell->latest.load(std::memory_order_acquire);
+}
+
+}  // namespace store
+}  // namespace ccomm

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: Apache-2.0
+// Builds small SystemConfigs in code for store/client/daemon tests (no XML needed).
+#pragma once
+
+#include <string>
+#include <unistd.h>
+
+#include "config/config.h"
+
+namespace ccomm {
+namespace testing {
+
+inline SignalConfig MakeSignal(const std::string& name, ValueType type, uint32_t count, SignalKind kind,
+                               uint32_t producer, std::vector<uint32_t> consumers) {
+  SignalConfig s;
+  s.name = name;
+  s.type = type;
+  s.count = count;
+  s.kind = kind;
+  s.producer = producer;
+  s.consumers = std::move(consumers);
+  return s;
+}
+
+/// Two nodes "a" (0) and "b" (1); signals chosen by the test.
+inline SystemConfig TwoNodeConfig(std::vector<SignalConfig> signals) {
+  SystemConfig cfg;
+  cfg.path = "test.xml";
+  NodeConfig a, b;
+  a.name = "a";
+  a.interface = "lo";
+  a.ip = "127.0.0.1";
+  b.name = "b";
+  b.interface = "lo";
+  b.ip = "127.0.0.2";
+  cfg.nodes = {a, b};
+  cfg.signals = std::move(signals);
+  cfg.hash = 0x1234u + static_cast<uint32_t>(cfg.signals.size());
+  return cfg;
+}
+
+/// A unique shm prefix per test process, so parallel test runs never share segments.
+inline std::string UniquePrefix(const char* tag) {
+  return "/ccomm-test-" + std::string(tag) + "-" + std::to_string(getpid()) + ".";
+}
+
+}  // namespace testing
+}  // namespace ccomm

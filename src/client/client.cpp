@@ -25,6 +25,8 @@ struct ccomm_client {
   uint32_t flags = 0;
   uint32_t signal_count = 0;
   RingCursor* cursors = nullptr;  // one per signal (used by event signals only)
+  bool pending_tx = false;        // CCOMM_OPEN_BATCH: forwarded writes since the last flush
+  bool pending_rx = false;        // CCOMM_OPEN_BATCH: any write since the last flush
 };
 
 namespace {
@@ -210,9 +212,17 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
     return r == StoreResult::kFull ? CCOMM_E_FULL : CCOMM_E_BUSY;
   }
   stats.writes.fetch_add(1, std::memory_order_relaxed);
-  if (d.flags & st::kSigForwarded)
-    c->segment.NotifyTx(id, !(c->flags & CCOMM_OPEN_NO_DOORBELL) && !(d.flags & st::kSigPeriodic));
-  if (!(c->flags & CCOMM_OPEN_NO_DOORBELL)) c->segment.NotifyRx();
+  const bool ring = !(c->flags & (CCOMM_OPEN_NO_DOORBELL | CCOMM_OPEN_BATCH));
+  if (d.flags & st::kSigForwarded) {
+    if (c->flags & CCOMM_OPEN_BATCH) {
+      c->segment.MarkDirty(id);
+      c->pending_tx = true;
+    } else {
+      c->segment.NotifyTx(id, ring && !(d.flags & st::kSigPeriodic));
+    }
+  }
+  if (ring) c->segment.NotifyRx();
+  else if (c->flags & CCOMM_OPEN_BATCH) c->pending_rx = true;
   else c->segment.header()->rx_doorbell.fetch_add(1, std::memory_order_release);
   return 0;
 }
@@ -255,6 +265,14 @@ int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v) {
   if (d.type != CCOMM_BOOL || d.count != 1) return CCOMM_E_TYPE;
   uint8_t b = v ? 1 : 0;
   return ccomm_write(c, s, &b, 1);
+}
+
+int ccomm_flush(ccomm_client* c) {
+  if (!c) return CCOMM_E_INVAL;
+  if (c->pending_tx) c->segment.RingTxDoorbell();
+  if (c->pending_rx) c->segment.NotifyRx();
+  c->pending_tx = c->pending_rx = false;
+  return 0;
 }
 
 int ccomm_wait(ccomm_client* c, int timeout_ms) {

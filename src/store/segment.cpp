@@ -146,12 +146,19 @@ int Segment::Find(const char* name) const {
   return -1;
 }
 
-void Segment::NotifyTx(uint32_t id, bool ring_doorbell) const {
-  dirty_words()[id / 64].fetch_or(1ull << (id % 64), std::memory_order_release);
+void Segment::RingTxDoorbell() const {
   SegmentHeader* h = header();
-  h->tx_doorbell.fetch_add(1, std::memory_order_release);
-  if (ring_doorbell && h->tx_sleeping.load(std::memory_order_seq_cst))
-    platform::FutexWake(&h->tx_doorbell, 1);
+  h->tx_doorbell.fetch_add(1, std::memory_order_seq_cst);
+  if (h->tx_sleeping.load(std::memory_order_seq_cst)) platform::FutexWake(&h->tx_doorbell, 1);
+}
+
+void Segment::NotifyTx(uint32_t id, bool wake) const {
+  MarkDirty(id);
+  if (wake) {
+    RingTxDoorbell();
+  } else {
+    header()->tx_doorbell.fetch_add(1, std::memory_order_release);
+  }
 }
 
 void Segment::NotifyRx() const {

@@ -63,8 +63,14 @@ class Segment {
   /// Signal id by name, or -1 (linear scan: start-up only).
   int Find(const char* name) const;
 
-  /// Marks a forwarded signal changed and rings ccommd's doorbell (see layout.h).
-  void NotifyTx(uint32_t id, bool ring_doorbell) const;
+  /// Marks a forwarded signal changed (ccommd collects it at its next wake-up).
+  void MarkDirty(uint32_t id) const {
+    dirty_words()[id / 64].fetch_or(1ull << (id % 64), std::memory_order_release);
+  }
+  /// Wakes ccommd's send thread if it sleeps (one FUTEX_WAKE only then).
+  void RingTxDoorbell() const;
+  /// MarkDirty, then bumps the doorbell, waking ccommd if `wake` (see layout.h).
+  void NotifyTx(uint32_t id, bool wake) const;
   /// Bumps rx_doorbell and wakes ccomm_wait() callers, if any.
   void NotifyRx() const;
 

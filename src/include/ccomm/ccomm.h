@@ -58,6 +58,8 @@ typedef enum ccomm_status {
 
 /** ccomm_open flags */
 #define CCOMM_OPEN_NO_DOORBELL 0x1u /**< writes never make a syscall (see above) */
+#define CCOMM_OPEN_BATCH 0x2u       /**< writes only mark signals; ccomm_flush() sends them all
+                                         in one frame per destination (one doorbell per cycle) */
 
 typedef struct ccomm_client ccomm_client;
 /** A signal handle (its id, the position in signals.xml); < 0 is invalid. */
@@ -122,6 +124,13 @@ CCOMM_API int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t le
  * error; nothing is half-written. Real-time safe (see the doorbell note above).
  */
 CCOMM_API int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len);
+
+/**
+ * With CCOMM_OPEN_BATCH: hands every signal written since the last flush to ccommd at
+ * once, so a control step's outputs travel in one frame. Call it at the end of each
+ * cycle. Without the flag it does nothing. Real-time safe (same doorbell note).
+ */
+CCOMM_API int ccomm_flush(ccomm_client* c);
 
 /* Typed scalar shortcuts: CCOMM_E_TYPE if the signal is not a scalar of that type. */
 CCOMM_API int ccomm_read_double(ccomm_client* c, ccomm_signal s, double* v, ccomm_info* info);

@@ -1,0 +1,269 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm: command-line access to a node's signals (list, echo, pub, stats, gen).
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+#include "ccomm/ccomm.h"
+#include "cli/values.h"
+#include "common/platform.h"
+#include "store/segment.h"
+
+namespace {
+
+const char kUsage[] =
+    "Usage: ccomm [--node NAME] COMMAND [ARGS]\n"
+    "Inspect and drive the signals of this board's ccommd (shared memory, no root needed\n"
+    "if you are in the 'ccomm' group).\n"
+    "\n"
+    "Commands:\n"
+    "  list                     every signal: type, kind, producer, status, age, value\n"
+    "  echo SIGNAL [-n N] [--timeout SEC] [--once]\n"
+    "                           print new values/events as they arrive (N of them; default\n"
+    "                           until Ctrl-C); --once prints the current value and status\n"
+    "  pub SIGNAL VALUE... [--rate HZ] [--count N]\n"
+    "                           write a value (arrays: one value per element, or one for all);\n"
+    "                           with --rate, repeat N times (default 1) at HZ\n"
+    "  stats [--json] [--watch SEC]\n"
+    "                           daemon, peer and signal counters: rates, loss, staleness\n"
+    "  gen 20sim4c SIGNALS.XML OUTDIR\n"
+    "                           generate the 20-sim 4C I/O component for this node\n"
+    "\n"
+    "Options:\n"
+    "  -n, --node NAME          node to attach to (default: $CCOMM_NODE, else hostname)\n"
+    "  -h, --help               this text\n"
+    "\n"
+    "Exit status: 0 ok; 1 error; 2 usage; 3 echo timed out before N values.\n"
+    "Status words: fresh, stale (older than stale_after_ms; '*' marks a safe value), never\n"
+    "(nothing received yet), empty (event signal, nothing new).\n";
+
+volatile sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+
+const char* StatusWord(int s) {
+  switch (s) {
+    case CCOMM_FRESH: return "fresh";
+    case CCOMM_STALE: return "stale";
+    case CCOMM_NEVER: return "never";
+    case CCOMM_EMPTY: return "empty";
+    default: return "error";
+  }
+}
+
+int Open(const char* node, ccomm_client** c) {
+  int r = ccomm_open(node, 0, c);
+  if (r != 0) {
+    std::string name = node ? node : (getenv("CCOMM_NODE") ? getenv("CCOMM_NODE") : "(hostname)");
+    fprintf(stderr, "ccomm: cannot attach to node %s: %s\n", name.c_str(), ccomm_strerror(r));
+    if (r == CCOMM_E_SYS) fprintf(stderr, "ccomm: %s (are you in the 'ccomm' group?)\n", strerror(errno));
+    return 1;
+  }
+  return 0;
+}
+
+ccomm_signal Find(ccomm_client* c, const char* name, ccomm_signal_desc* d) {
+  ccomm_signal s = ccomm_find(c, name);
+  if (s < 0) {
+    fprintf(stderr, "ccomm: no signal '%s' on node %s (see: ccomm list)\n", name, ccomm_node_name(c));
+    return s;
+  }
+  ccomm_describe(c, s, d);
+  return s;
+}
+
+int CmdList(ccomm_client* c) {
+  printf("%-4s %-24s %-12s %-6s %-10s %-6s %10s  %s\n", "ID", "NAME", "TYPE", "KIND", "PRODUCER", "STATUS",
+         "AGE_MS", "VALUE");
+  std::vector<uint8_t> buf;
+  for (int i = 0; i < ccomm_signal_count(c); ++i) {
+    ccomm_signal_desc d;
+    ccomm_describe(c, i, &d);
+    char type[32];
+    if (d.count == 1) snprintf(type, sizeof type, "%s", ccomm::cli::TypeName(d.type));
+    else snprintf(type, sizeof type, "%s[%u]", ccomm::cli::TypeName(d.type), d.count);
+    std::string value = "-", status = d.is_event ? "event" : "-";
+    char age[32] = "-";
+    if (!d.is_event) {
+      buf.assign(d.value_bytes, 0);
+      ccomm_info info;
+      int r = ccomm_read(c, i, buf.data(), buf.size(), &info);
+      status = r >= 0 ? StatusWord(r) : ccomm_strerror(r);
+      if (r == CCOMM_FRESH || r == CCOMM_STALE) {
+        value = ccomm::cli::FormatValue(d, buf.data());
+        snprintf(age, sizeof age, "%.1f", static_cast<double>(info.age_ns) / 1e6);
+      }
+    }
+    printf("%-4d %-24s %-12s %-6s %-10s %-6s %10s  %s\n", i, d.name, type, d.is_event ? "event" : "state",
+           d.producer, status.c_str(), age, value.c_str());
+  }
+  return 0;
+}
+
+int CmdEcho(ccomm_client* c, int argc, char** argv) {
+  long count = -1;
+  double timeout = -1;
+  bool once = false;
+  static const struct option kLong[] = {{"count", required_argument, nullptr, 'n'},
+                                        {"timeout", required_argument, nullptr, 't'},
+                                        {"once", no_argument, nullptr, 'o'},
+                                        {nullptr, 0, nullptr, 0}};
+  optind = 1;
+  int ch;
+  while ((ch = getopt_long(argc, argv, "n:t:", kLong, nullptr)) != -1) {
+    if (ch == 'n') count = strtol(optarg, nullptr, 10);
+    else if (ch == 't') timeout = strtod(optarg, nullptr);
+    else if (ch == 'o') once = true;
+    else return 2;
+  }
+  if (optind != argc - 1) {
+    fprintf(stderr, "ccomm echo: give exactly one SIGNAL\n");
+    return 2;
+  }
+  ccomm_signal_desc d;
+  ccomm_signal s = Find(c, argv[optind], &d);
+  if (s < 0) return 1;
+  std::vector<uint8_t> buf(d.value_bytes);
+  uint64_t start = ccomm::platform::MonotonicNs(), last_seq = 0;
+  long printed = 0;
+  bool first = true;
+  while (!g_stop && (count < 0 || printed < count)) {
+    ccomm_info info;
+    int r = ccomm_read(c, s, buf.data(), buf.size(), &info);
+    if (r < 0) {
+      fprintf(stderr, "ccomm echo: %s\n", ccomm_strerror(r));
+      return 1;
+    }
+    bool show = once || (d.is_event ? r == CCOMM_FRESH : (r != CCOMM_NEVER && (first || info.seq != last_seq)));
+    if (show) {
+      printf("%s %s %s%s seq=%" PRIu64 " age_us=%" PRId64 " lost=%" PRIu64 "\n", d.name,
+             (r == CCOMM_NEVER || r == CCOMM_EMPTY) && !(info.flags & CCOMM_INFO_SAFE_VALUE)
+                 ? "-" : ccomm::cli::FormatValue(d, buf.data()).c_str(),
+             StatusWord(r), (info.flags & CCOMM_INFO_SAFE_VALUE) ? "*" : "", info.seq,
+             info.age_ns >= 0 ? info.age_ns / 1000 : -1, info.lost);
+      fflush(stdout);
+      last_seq = info.seq;
+      first = false;
+      printed++;
+      if (once) return 0;
+      if (d.is_event) continue;  // drain queued events before waiting
+    }
+    if (timeout >= 0 && (ccomm::platform::MonotonicNs() - start) / 1e9 > timeout) break;
+    ccomm_wait(c, 100);
+  }
+  return (count >= 0 && printed < count) ? 3 : 0;
+}
+
+int CmdPub(ccomm_client* c, int argc, char** argv) {
+  double rate = 0;
+  long count = 1;
+  static const struct option kLong[] = {{"rate", required_argument, nullptr, 'r'},
+                                        {"count", required_argument, nullptr, 'n'},
+                                        {nullptr, 0, nullptr, 0}};
+  optind = 1;
+  int ch;
+  // "+" stops at the first non-option so negative values ("-1.5") are not options.
+  while ((ch = getopt_long(argc, argv, "+r:n:", kLong, nullptr)) != -1) {
+    if (ch == 'r') rate = strtod(optarg, nullptr);
+    else if (ch == 'n') count = strtol(optarg, nullptr, 10);
+    else return 2;
+  }
+  if (argc - optind < 2) {
+    fprintf(stderr, "ccomm pub: give SIGNAL and VALUE...\n");
+    return 2;
+  }
+  ccomm_signal_desc d;
+  ccomm_signal s = Find(c, argv[optind], &d);
+  if (s < 0) return 1;
+  std::vector<uint8_t> buf(d.value_bytes);
+  std::string err;
+  if (!ccomm::cli::ParseValue(d, argc - optind - 1, argv + optind + 1, buf.data(), &err)) {
+    fprintf(stderr, "ccomm pub: %s: %s\n", d.name, err.c_str());
+    return 1;
+  }
+  struct timespec next;
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  long period_ns = rate > 0 ? static_cast<long>(1e9 / rate) : 0;
+  for (long i = 0; i < count && !g_stop; ++i) {
+    int r = ccomm_write(c, s, buf.data(), buf.size());
+    if (r != 0) {
+      fprintf(stderr, "ccomm pub: %s: %s\n", d.name, ccomm_strerror(r));
+      return 1;
+    }
+    if (period_ns && i + 1 < count) {
+      next.tv_nsec += period_ns;
+      while (next.tv_nsec >= 1000000000) { next.tv_nsec -= 1000000000; next.tv_sec++; }
+      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    }
+  }
+  return 0;
+}
+
+int CmdGen(int argc, char** argv) {
+  if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
+    fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
+    return 2;
+  }
+  // The generator is a Python script installed with the integrations.
+  const char* gen = getenv("CCOMM_GEN_20SIM4C");
+  std::string path = gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py";
+  std::vector<char*> args;
+  std::string py = "python3";
+  args.push_back(&py[0]);
+  args.push_back(&path[0]);
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execvp("python3", args.data());
+  fprintf(stderr, "ccomm gen: cannot run python3 %s: %s\n", path.c_str(), strerror(errno));
+  return 1;
+}
+
+}  // namespace
+
+int CmdStats(ccomm_client* c, const char* node, int argc, char** argv);  // stats.cpp
+
+int main(int argc, char** argv) {
+  const char* node = nullptr;
+  static const struct option kLong[] = {{"node", required_argument, nullptr, 'n'},
+                                        {"help", no_argument, nullptr, 'h'},
+                                        {nullptr, 0, nullptr, 0}};
+  int ch;
+  while ((ch = getopt_long(argc, argv, "+n:h", kLong, nullptr)) != -1) {
+    if (ch == 'n') node = optarg;
+    else if (ch == 'h') { fputs(kUsage, stdout); return 0; }
+    else { fputs(kUsage, stderr); return 2; }
+  }
+  if (optind >= argc) {
+    fputs(kUsage, stderr);
+    return 2;
+  }
+  signal(SIGINT, OnSignal);
+  signal(SIGTERM, OnSignal);
+  const char* cmd = argv[optind];
+  int sub_argc = argc - optind;
+  char** sub_argv = argv + optind;
+  if (strcmp(cmd, "gen") == 0) return CmdGen(sub_argc, sub_argv);
+  if (strcmp(cmd, "help") == 0) { fputs(kUsage, stdout); return 0; }
+  if (strcmp(cmd, "list") && strcmp(cmd, "echo") && strcmp(cmd, "pub") && strcmp(cmd, "stats")) {
+    fprintf(stderr, "ccomm: unknown command '%s'\n%s", cmd, kUsage);
+    return 2;
+  }
+  ccomm_client* c = nullptr;
+  if (Open(node, &c) != 0) return 1;
+  int r = 2;
+  if (strcmp(cmd, "list") == 0) r = CmdList(c);
+  else if (strcmp(cmd, "echo") == 0) r = CmdEcho(c, sub_argc, sub_argv);
+  else if (strcmp(cmd, "pub") == 0) r = CmdPub(c, sub_argc, sub_argv);
+  else if (strcmp(cmd, "stats") == 0) r = CmdStats(c, node, sub_argc, sub_argv);
+  ccomm_close(c);
+  return r;
+}

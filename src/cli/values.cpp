@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "cli/values.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <vector>
+
+namespace ccomm {
+namespace cli {
+
+const char* TypeName(int type) {
+  switch (type) {
+    case CCOMM_BOOL: return "bool";
+    case CCOMM_INT32: return "int32";
+    case CCOMM_UINT32: return "uint32";
+    case CCOMM_INT64: return "int64";
+    case CCOMM_FLOAT: return "float";
+    case CCOMM_DOUBLE: return "double";
+    default: return "?";
+  }
+}
+
+static size_t ElemSize(int type) {
+  switch (type) {
+    case CCOMM_BOOL: return 1;
+    case CCOMM_INT64: case CCOMM_DOUBLE: return 8;
+    default: return 4;
+  }
+}
+
+static std::string FormatOne(int type, const uint8_t* p) {
+  char buf[64];
+  switch (type) {
+    case CCOMM_BOOL: return *p ? "true" : "false";
+    case CCOMM_INT32: { int32_t v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%" PRId32, v); break; }
+    case CCOMM_UINT32: { uint32_t v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%" PRIu32, v); break; }
+    case CCOMM_INT64: { int64_t v; memcpy(&v, p, 8); snprintf(buf, sizeof buf, "%" PRId64, v); break; }
+    case CCOMM_FLOAT: { float v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%.9g", static_cast<double>(v)); break; }
+    case CCOMM_DOUBLE: { double v; memcpy(&v, p, 8); snprintf(buf, sizeof buf, "%.17g", v); break; }
+    default: return "?";
+  }
+  return buf;
+}
+
+std::string FormatValue(const ccomm_signal_desc& d, const void* value) {
+  const uint8_t* p = static_cast<const uint8_t*>(value);
+  size_t es = ElemSize(d.type);
+  if (d.count == 1) return FormatOne(d.type, p);
+  std::string s = "[";
+  for (uint32_t i = 0; i < d.count; ++i) {
+    if (i) s += ", ";
+    s += FormatOne(d.type, p + i * es);
+  }
+  return s + "]";
+}
+
+static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* error) {
+  const char* s = w.c_str();
+  char* end = nullptr;
+  errno = 0;
+  switch (type) {
+    case CCOMM_BOOL:
+      if (w == "1" || w == "true") { *out = 1; return true; }
+      if (w == "0" || w == "false") { *out = 0; return true; }
+      *error = "'" + w + "' is not a bool (0, 1, true, false)";
+      return false;
+    case CCOMM_INT32: case CCOMM_INT64: {
+      long long v = strtoll(s, &end, 0);
+      if (*s == '\0' || *end || errno || (type == CCOMM_INT32 && (v < INT32_MIN || v > INT32_MAX))) {
+        *error = "'" + w + "' is not a valid " + TypeName(type);
+        return false;
+      }
+      if (type == CCOMM_INT32) { int32_t x = static_cast<int32_t>(v); memcpy(out, &x, 4); }
+      else { int64_t x = v; memcpy(out, &x, 8); }
+      return true;
+    }
+    case CCOMM_UINT32: {
+      unsigned long long v = strtoull(s, &end, 0);
+      if (*s == '\0' || *s == '-' || *end || errno || v > UINT32_MAX) {
+        *error = "'" + w + "' is not a valid uint32";
+        return false;
+      }
+      uint32_t x = static_cast<uint32_t>(v);
+      memcpy(out, &x, 4);
+      return true;
+    }
+    case CCOMM_FLOAT: case CCOMM_DOUBLE: {
+      double v = strtod(s, &end);
+      if (*s == '\0' || *end || (errno == ERANGE && isinf(v))) {
+        *error = "'" + w + "' is not a number";
+        return false;
+      }
+      if (type == CCOMM_FLOAT) { float x = static_cast<float>(v); memcpy(out, &x, 4); }
+      else memcpy(out, &v, 8);
+      return true;
+    }
+    default:
+      *error = "unknown type";
+      return false;
+  }
+}
+
+bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error) {
+  std::vector<std::string> parts;
+  for (int i = 0; i < n; ++i) {
+    std::string w = words[i];
+    size_t start = 0;
+    for (;;) {
+      size_t comma = w.find(',', start);
+      std::string p = w.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      while (!p.empty() && (p[0] == '[' || p[0] == ' ')) p.erase(0, 1);
+      while (!p.empty() && (p.back() == ']' || p.back() == ' ')) p.pop_back();
+      if (!p.empty()) parts.push_back(p);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  if (parts.size() != 1 && parts.size() != d.count) {
+    char buf[96];
+    snprintf(buf, sizeof buf, "expected 1 or %u values, got %zu", d.count, parts.size());
+    *error = buf;
+    return false;
+  }
+  uint8_t* p = static_cast<uint8_t*>(out);
+  size_t es = ElemSize(d.type);
+  for (uint32_t i = 0; i < d.count; ++i)
+    if (!ParseOne(d.type, parts.size() == 1 ? parts[0] : parts[i], p + i * es, error)) return false;
+  return true;
+}
+
+}  // namespace cli
+}  // namespace ccomm

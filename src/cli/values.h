@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: Apache-2.0
+// Text <-> value conversion for the CLI (host byte order, as in shared memory).
+#pragma once
+
+#include <string>
+
+#include "ccomm/ccomm.h"
+
+namespace ccomm {
+namespace cli {
+
+const char* TypeName(int type);
+/// "1.5" for scalars, "[1, 2, 3]" for arrays.
+std::string FormatValue(const ccomm_signal_desc& d, const void* value);
+/// Parses n words (one for all elements, or one per element; commas also separate).
+/// False with a message on any malformed or out-of-range word.
+bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error);
+
+}  // namespace cli
+}  // namespace ccomm

@@ -1,0 +1,283 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm wire format v1 codec (layout in docs/protocol.md).
+//
+// Every multi-byte field is read and written with memcpy plus an explicit byte swap, so
+// the code has no alignment requirement and no type-punning UB on any target. Every
+// access is checked against the buffer bounds before it happens.
+#include "wire/wire.h"
+
+#include <cstring>
+
+namespace ccomm {
+namespace wire {
+namespace {
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+inline uint16_t Swap(uint16_t v) { return v; }
+inline uint32_t Swap(uint32_t v) { return v; }
+inline uint64_t Swap(uint64_t v) { return v; }
+#else
+inline uint16_t Swap(uint16_t v) { return __builtin_bswap16(v); }
+inline uint32_t Swap(uint32_t v) { return __builtin_bswap32(v); }
+inline uint64_t Swap(uint64_t v) { return __builtin_bswap64(v); }
+#endif
+
+template <typename T>
+inline T Load(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return Swap(v);
+}
+
+template <typename T>
+inline void Store(uint8_t* p, T v) {
+  v = Swap(v);
+  std::memcpy(p, &v, sizeof v);
+}
+
+// Field offsets, see docs/protocol.md.
+constexpr size_t kOffMagic = 0, kOffVersion = 4, kOffFlags = 5, kOffSender = 6, kOffHash = 8,
+                 kOffSeq = 12, kOffTime = 16, kOffCount = 24, kOffPayload = 26, kOffDest = 28,
+                 kOffReserved = 30;
+constexpr size_t kEOffSignal = 0, kEOffType = 2, kEOffFlags = 3, kEOffCount = 4, kEOffLen = 6,
+                 kEOffSeq = 8, kEOffReserved = 12, kEOffTime = 16;
+
+constexpr uint8_t kKnownFrameFlags = kFlagHeartbeat | kFlagAuth;
+constexpr uint8_t kKnownEntryFlags = kEntryEvent;
+constexpr uint8_t kTypeBool = 1;
+
+// Element size of a wire type code, 0 if unknown. The codes match ccomm::ValueType;
+// wire does not depend on the config module.
+inline size_t ElementSize(uint8_t type) {
+  switch (type) {
+    case 1: return 1;             // bool
+    case 2: case 3: case 5: return 4;  // int32, uint32, float
+    case 4: case 6: return 8;     // int64, double
+    default: return 0;
+  }
+}
+
+inline size_t Padded(size_t n) { return (n + 7u) & ~size_t{7}; }
+
+// Declared total length (header + payload + tag) of a header already known to be
+// kHeaderSize bytes long.
+inline size_t DeclaredLength(const uint8_t* buf) {
+  size_t total = kHeaderSize + Load<uint16_t>(buf + kOffPayload);
+  if (buf[kOffFlags] & kFlagAuth) total += kAuthTagSize;
+  return total;
+}
+
+// Checks one entry at `p` with `left` payload bytes remaining; on success stores its wire
+// size in *size.
+DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
+  if (left < kEntryHeaderSize) return DecodeError::kBadEntry;
+  const uint8_t type = p[kEOffType];
+  const size_t esize = ElementSize(type);
+  if (esize == 0) return DecodeError::kBadEntry;
+  if (p[kEOffFlags] & ~kKnownEntryFlags) return DecodeError::kBadEntry;
+  const size_t count = Load<uint16_t>(p + kEOffCount);
+  const size_t value_len = Load<uint16_t>(p + kEOffLen);
+  if (count == 0 || value_len != count * esize) return DecodeError::kBadEntry;
+  if (Load<uint32_t>(p + kEOffReserved) != 0) return DecodeError::kBadEntry;
+  const size_t total = kEntryHeaderSize + Padded(value_len);
+  if (total > left) return DecodeError::kBadEntry;
+  const uint8_t* v = p + kEntryHeaderSize;
+  if (type == kTypeBool) {
+    for (size_t i = 0; i < value_len; ++i) {
+      if (v[i] > 1) return DecodeError::kBadEntry;
+    }
+  }
+  for (size_t i = value_len; i < Padded(value_len); ++i) {
+    if (v[i] != 0) return DecodeError::kBadEntry;
+  }
+  *size = total;
+  return DecodeError::kOk;
+}
+
+}  // namespace
+
+const char* DecodeErrorName(DecodeError e) {
+  switch (e) {
+    case DecodeError::kOk: return "ok";
+    case DecodeError::kTooShort: return "too_short";
+    case DecodeError::kBadMagic: return "bad_magic";
+    case DecodeError::kBadVersion: return "bad_version";
+    case DecodeError::kBadHeader: return "bad_header";
+    case DecodeError::kBadEntry: return "bad_entry";
+    case DecodeError::kTrailingBytes: return "trailing_bytes";
+  }
+  return "unknown";
+}
+
+void FrameWriter::Begin(const FrameHeader& h) {
+  len_ = 0;
+  count_ = 0;
+  limit_ = 0;
+  if (buf_ == nullptr || cap_ < kHeaderSize || (h.flags & ~kKnownFrameFlags) != 0) return;
+  const size_t max = kMaxFrameSize - ((h.flags & kFlagAuth) ? kAuthTagSize : 0);
+  limit_ = cap_ < max ? cap_ : max;
+  Store<uint32_t>(buf_ + kOffMagic, kMagic);
+  buf_[kOffVersion] = kVersion;  // this codec writes v1 only, whatever h.version says
+  buf_[kOffFlags] = h.flags;
+  Store<uint16_t>(buf_ + kOffSender, h.sender);
+  Store<uint32_t>(buf_ + kOffHash, h.config_hash);
+  Store<uint32_t>(buf_ + kOffSeq, h.seq);
+  Store<uint64_t>(buf_ + kOffTime, h.send_time_ns);
+  Store<uint16_t>(buf_ + kOffCount, 0);
+  Store<uint16_t>(buf_ + kOffPayload, 0);
+  Store<uint16_t>(buf_ + kOffDest, h.dest);
+  Store<uint16_t>(buf_ + kOffReserved, 0);
+  len_ = kHeaderSize;
+}
+
+bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
+                      uint64_t source_time_ns, const void* value, size_t value_len) {
+  if (len_ < kHeaderSize) return false;                 // no successful Begin
+  if (buf_[kOffFlags] & kFlagHeartbeat) return false;  // heartbeats carry no entries
+  if (count_ == UINT16_MAX) return false;
+  const size_t esize = ElementSize(type);
+  if (esize == 0 || count == 0 || value_len != size_t{count} * esize) return false;
+  if ((flags & ~kKnownEntryFlags) != 0 || value == nullptr) return false;
+  // limit_ <= kMaxFrameSize, so value_len and the sizes below stay far from overflow
+  // once this check passes.
+  if (value_len > limit_ || EntrySize(value_len) > limit_ - len_) return false;
+
+  uint8_t* p = buf_ + len_;
+  Store<uint16_t>(p + kEOffSignal, signal);
+  p[kEOffType] = type;
+  p[kEOffFlags] = flags;
+  Store<uint16_t>(p + kEOffCount, count);
+  Store<uint16_t>(p + kEOffLen, static_cast<uint16_t>(value_len));
+  Store<uint32_t>(p + kEOffSeq, seq);
+  Store<uint32_t>(p + kEOffReserved, 0);
+  Store<uint64_t>(p + kEOffTime, source_time_ns);
+
+  uint8_t* v = p + kEntryHeaderSize;
+  const uint8_t* src = static_cast<const uint8_t*>(value);
+  switch (esize) {
+    case 1:  // bool: any non-zero host byte is true, the wire carries 0 or 1 only
+      for (size_t i = 0; i < count; ++i) v[i] = src[i] != 0 ? 1 : 0;
+      break;
+    case 4:
+      for (size_t i = 0; i < count; ++i) {
+        uint32_t x;
+        std::memcpy(&x, src + 4 * i, 4);
+        Store<uint32_t>(v + 4 * i, x);
+      }
+      break;
+    default:
+      for (size_t i = 0; i < count; ++i) {
+        uint64_t x;
+        std::memcpy(&x, src + 8 * i, 8);
+        Store<uint64_t>(v + 8 * i, x);
+      }
+      break;
+  }
+  std::memset(v + value_len, 0, Padded(value_len) - value_len);
+  len_ += EntrySize(value_len);
+  ++count_;
+  return true;
+}
+
+size_t FrameWriter::Finish() {
+  if (len_ < kHeaderSize) return 0;
+  if (count_ == 0 && !(buf_[kOffFlags] & kFlagHeartbeat)) return 0;
+  Store<uint16_t>(buf_ + kOffCount, count_);
+  Store<uint16_t>(buf_ + kOffPayload, static_cast<uint16_t>(len_ - kHeaderSize));
+  return len_;
+}
+
+DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
+  if (buf == nullptr || len < kHeaderSize) return DecodeError::kTooShort;
+  if (Load<uint32_t>(buf + kOffMagic) != kMagic) return DecodeError::kBadMagic;
+  if (buf[kOffVersion] != kVersion) return DecodeError::kBadVersion;
+  const uint8_t flags = buf[kOffFlags];
+  if ((flags & ~kKnownFrameFlags) != 0) return DecodeError::kBadHeader;
+  if (Load<uint16_t>(buf + kOffReserved) != 0) return DecodeError::kBadHeader;
+  const uint16_t entry_count = Load<uint16_t>(buf + kOffCount);
+  const uint16_t payload_len = Load<uint16_t>(buf + kOffPayload);
+  // One encoding per meaning: heartbeats are exactly the frames without entries.
+  if (flags & kFlagHeartbeat) {
+    if (entry_count != 0 || payload_len != 0) return DecodeError::kBadHeader;
+  } else if (entry_count == 0 || payload_len == 0) {
+    return DecodeError::kBadHeader;
+  }
+  if (payload_len % 8 != 0) return DecodeError::kBadHeader;  // every entry is a multiple of 8
+  const size_t total = DeclaredLength(buf);
+  if (total > kMaxFrameSize) return DecodeError::kBadHeader;
+  if (len < total) return DecodeError::kTooShort;
+  if (len > total) return DecodeError::kTrailingBytes;
+
+  const uint8_t* p = buf + kHeaderSize;
+  size_t left = payload_len;
+  for (uint16_t i = 0; i < entry_count; ++i) {
+    size_t size = 0;
+    const DecodeError e = CheckEntry(p, left, &size);
+    if (e != DecodeError::kOk) return e;
+    p += size;
+    left -= size;
+  }
+  if (left != 0) return DecodeError::kBadHeader;  // entries do not fill payload_len
+
+  h->version = buf[kOffVersion];
+  h->flags = flags;
+  h->sender = Load<uint16_t>(buf + kOffSender);
+  h->config_hash = Load<uint32_t>(buf + kOffHash);
+  h->seq = Load<uint32_t>(buf + kOffSeq);
+  h->send_time_ns = Load<uint64_t>(buf + kOffTime);
+  h->entry_count = entry_count;
+  h->payload_len = payload_len;
+  h->dest = Load<uint16_t>(buf + kOffDest);
+  return DecodeError::kOk;
+}
+
+size_t TrimEthernetPadding(const uint8_t* buf, size_t len) {
+  if (buf == nullptr || len < kHeaderSize || len > kEthMinPayload) return len;
+  const size_t total = DeclaredLength(buf);
+  if (total >= len) return len;
+  for (size_t i = total; i < len; ++i) {
+    if (buf[i] != 0) return len;  // not padding: let DecodeHeader report trailing bytes
+  }
+  return total;
+}
+
+bool EntryIterator::Next(EntryView* e) {
+  if (left_ == 0) return false;
+  e->signal = Load<uint16_t>(p_ + kEOffSignal);
+  e->type = p_[kEOffType];
+  e->flags = p_[kEOffFlags];
+  e->count = Load<uint16_t>(p_ + kEOffCount);
+  e->value_len = Load<uint16_t>(p_ + kEOffLen);
+  e->seq = Load<uint32_t>(p_ + kEOffSeq);
+  e->source_time_ns = Load<uint64_t>(p_ + kEOffTime);
+  e->value = p_ + kEntryHeaderSize;
+  p_ += FrameWriter::EntrySize(e->value_len);
+  --left_;
+  return true;
+}
+
+void ValueToHost(uint8_t type, const uint8_t* src, void* dst, size_t count) {
+  uint8_t* d = static_cast<uint8_t*>(dst);
+  switch (ElementSize(type)) {
+    case 1:
+      std::memcpy(d, src, count);
+      break;
+    case 4:
+      for (size_t i = 0; i < count; ++i) {
+        const uint32_t x = Load<uint32_t>(src + 4 * i);
+        std::memcpy(d + 4 * i, &x, 4);
+      }
+      break;
+    case 8:
+      for (size_t i = 0; i < count; ++i) {
+        const uint64_t x = Load<uint64_t>(src + 8 * i);
+        std::memcpy(d + 8 * i, &x, 8);
+      }
+      break;
+    default:
+      break;  // unknown type: nothing to convert (DecodeHeader never accepts one)
+  }
+}
+
+}  // namespace wire
+}  // namespace ccomm

@@ -64,6 +64,7 @@ static void usage(FILE *f)
             "  raw:  --if IFNAME [--ethertype 0x88B6] [--dst MAC|broadcast]\n"
             "  udp:  [--bind ADDR:PORT] (echo/sink default 0.0.0.0:%d) --peer ADDR:PORT (ping/source)\n"
             "  --persist          echo: keep serving after a FIN\n"
+            "  --echo-limit N     echo: exit after answering N PINGs (tests of loss accounting)\n"
             "  --idle-ms MS       echo/sink: exit after MS without traffic once started (default 0 = never\n"
             "                     for echo, 2000 for sink)\n"
             "  --start-wait-ms MS ping/source: how long to probe for the peer (default 10000)\n" BENCH_COMMON_HELP
@@ -264,6 +265,7 @@ struct run {
     enum role role;
     struct endpoint ep;
     int persist;
+    uint64_t echo_limit; /* echo: exit after answering this many measured PINGs (0 = no limit) */
     int64_t idle_ns;
     int64_t start_wait_ns;
     size_t msg_len; /* header + payload */
@@ -302,8 +304,8 @@ static int run_echo(struct run *r)
         last = bench_now_ns();
         if (type == BENCH_MSG_PING) {
             reply(r, m, (size_t)n, BENCH_MSG_PONG);
-            if (seq != PROBE_SEQ)
-                echoed++;
+            if (seq != PROBE_SEQ && ++echoed == r->echo_limit)
+                break;
         } else if (type == BENCH_MSG_FIN && !r->persist) {
             break;
         }
@@ -539,7 +541,7 @@ int main(int argc, char **argv)
     int have_t = 0, have_r = 0, have_bind = 0;
     enum {
         OPT_T = 0x200, OPT_ROLE, OPT_IF, OPT_ET, OPT_DST, OPT_BIND, OPT_PEER, OPT_PERSIST, OPT_IDLE, OPT_START,
-        OPT_HELP
+        OPT_LIMIT, OPT_HELP
     };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"transport", required_argument, 0, OPT_T},
@@ -550,6 +552,7 @@ int main(int argc, char **argv)
                                              {"bind", required_argument, 0, OPT_BIND},
                                              {"peer", required_argument, 0, OPT_PEER},
                                              {"persist", no_argument, 0, OPT_PERSIST},
+                                             {"echo-limit", required_argument, 0, OPT_LIMIT},
                                              {"idle-ms", required_argument, 0, OPT_IDLE},
                                              {"start-wait-ms", required_argument, 0, OPT_START},
                                              {"help", no_argument, 0, OPT_HELP},
@@ -602,6 +605,7 @@ int main(int argc, char **argv)
             r.ep.peer_given = 1;
             break;
         case OPT_PERSIST: r.persist = 1; break;
+        case OPT_LIMIT: bad = bench_parse_u64(optarg, &r.echo_limit) != 0; break;
         case OPT_IDLE:
             bad = bench_parse_u64(optarg, &u) != 0;
             r.idle_ns = (int64_t)u * 1000000LL;

@@ -1,0 +1,145 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Running the bench programs: foreground measurement, background partner, netns.
+
+Every process started here is remembered and ended by its own pid when the run
+ends (normally, on an exception, or on SIGINT/SIGTERM), never by name.
+"""
+
+import os
+import signal
+import subprocess
+import time
+
+from . import results
+
+EXIT_SKIP = 4
+_HERE = os.path.dirname(os.path.abspath(__file__))
+NETNS_SH = os.path.join(_HERE, "netns.sh")
+
+_children = []
+
+
+class Skip(Exception):
+    """A measurement cannot run here (no root, missing program or facility)."""
+
+
+class Failed(Exception):
+    """A measurement ran and failed."""
+
+
+def start_background(argv, log_path):
+    """Start a partner process (echo, iox-roudi) with output to log_path."""
+    log = open(log_path, "w")
+    p = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                         start_new_session=True)
+    log.close()
+    p.log_path = log_path
+    _children.append(p)
+    return p
+
+
+def stop(p, grace=2.0):
+    """End one process we started: wait `grace` s for it to exit by itself, then SIGTERM, then SIGKILL."""
+    if p is None:
+        return None
+    try:
+        return p.wait(timeout=grace)
+    except subprocess.TimeoutExpired:
+        pass
+    for sig, wait in ((signal.SIGTERM, 3.0), (signal.SIGKILL, 3.0)):
+        try:
+            # The partner runs in its own session (start_new_session): its group is its own.
+            os.killpg(p.pid, sig)
+        except ProcessLookupError:
+            break
+        try:
+            return p.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            continue
+    return p.poll()
+
+
+def stop_all():
+    while _children:
+        stop(_children.pop(), grace=0.2)
+
+
+def forget(p):
+    if p in _children:
+        _children.remove(p)
+
+
+def run_measurement(argv, timeout, log_path=None):
+    """Run a program that prints one result line; return the validated row.
+
+    Exit 4 means "skipped here" (e.g. no permission), anything else non-zero is a failure.
+    """
+    try:
+        cp = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            timeout=timeout, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired as e:
+        raise Failed("%s timed out after %ss" % (os.path.basename(argv[0]), timeout)) from e
+    if log_path:
+        with open(log_path, "w") as f:
+            f.write("$ %s\n%s\n--- stderr ---\n%s" % (" ".join(argv), cp.stdout, cp.stderr))
+    if cp.returncode == EXIT_SKIP:
+        raise Skip((cp.stderr.strip().splitlines() or ["skipped"])[-1])
+    if cp.returncode != 0:
+        tail = " | ".join(cp.stderr.strip().splitlines()[-3:])
+        raise Failed("%s exited %d: %s" % (" ".join(argv[:4]), cp.returncode, tail))
+    return results.parse_program_output(cp.stdout)
+
+
+def wait_for_text(path, text, timeout, proc=None):
+    """Poll a log file until it contains `text`; False on timeout or if `proc` died."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            with open(path, errors="replace") as f:
+                if text in f.read():
+                    return True
+        except FileNotFoundError:
+            pass
+        if proc is not None and proc.poll() is not None:
+            return False
+        time.sleep(0.05)
+    return False
+
+
+class NetnsPair:
+    """Two namespaces joined by veth (scripts/benchlib/netns.sh): ns_a/ns_b, eth0 in each."""
+
+    IP_A, IP_B = "198.18.76.1", "198.18.76.2"
+    MAC_A, MAC_B = "02:cc:b0:00:00:01", "02:cc:b0:00:00:02"
+
+    def __init__(self, prefix="ccb"):
+        self.prefix = prefix
+        self.ns_a, self.ns_b = prefix + "-a", prefix + "-b"
+        self.up = False
+
+    def _sh(self, cmd):
+        env = dict(os.environ, CCB_PREFIX=self.prefix)
+        return subprocess.run(["sh", NETNS_SH, cmd], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+
+    def __enter__(self):
+        if os.geteuid() != 0:
+            raise Skip("network namespaces need root")
+        cp = self._sh("up")
+        if cp.returncode == EXIT_SKIP:
+            raise Skip(cp.stderr.strip() or "netns not available")
+        if cp.returncode != 0:
+            raise Failed("netns up: " + cp.stderr.strip())
+        self.up = True
+        return self
+
+    def __exit__(self, *exc):
+        if self.up:
+            self._sh("down")
+            self.up = False
+        return False
+
+    def wrap(self, side, argv):
+        """argv run inside namespace 'a' or 'b'."""
+        ns = self.ns_a if side == "a" else self.ns_b
+        return ["ip", "netns", "exec", ns] + list(argv)

@@ -1,0 +1,249 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Tests of the bench programs and of benchlib (run from scripts/):
+
+    CCOMM_BENCH_BIN=<dir with shm_floor, net_floor> python3 -m unittest -v benchlib.test_benchlib
+
+Program tests are skipped when the programs are not found; the ones needing
+network namespaces are skipped unless run as root.
+"""
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+from . import procs, results
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+
+
+def _bin_dir():
+    for d in (os.environ.get("CCOMM_BENCH_BIN"), os.path.join(REPO, "build-bench-floors", "bin")):
+        if d and os.path.exists(os.path.join(d, "shm_floor")):
+            return d
+    return None
+
+
+BIN = _bin_dir()
+
+
+def prog(name):
+    p = os.path.join(BIN, name) if BIN else None
+    if not p or not os.path.exists(p):
+        raise unittest.SkipTest("%s not built" % name)
+    return p
+
+
+def free_udp_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class StatsTest(unittest.TestCase):
+    def test_nearest_rank(self):
+        v = list(range(1, 101))  # 1..100
+        self.assertEqual(results.percentile(v, 0.50), 50)
+        self.assertEqual(results.percentile(v, 0.90), 90)
+        self.assertEqual(results.percentile(v, 0.99), 99)
+        self.assertEqual(results.percentile(v, 0.999), 100)
+        self.assertEqual(results.percentile([7], 0.5), 7)
+        self.assertEqual(results.percentile([], 0.5), 0)
+
+    def test_row_from_samples(self):
+        r = results.row_from_samples("x", "shm", 8, 0, [30, 10, 20], lost=2, metric="rtt")
+        self.assertEqual((r["min_ns"], r["p50_ns"], r["max_ns"], r["count"], r["lost"]), (10, 20, 30, 3, 2))
+        self.assertAlmostEqual(r["mean_ns"], 20.0)
+
+    def test_validate_rejects(self):
+        good = results.row_from_samples("x", "udp", 8, 1000, [1, 2, 3], 0)
+        for f in results.SCHEMA_FIELDS:
+            bad = dict(good)
+            del bad[f]
+            with self.assertRaises(results.SchemaError):
+                results.validate(bad)
+        bad = dict(good, p50_ns=5)  # above p90
+        with self.assertRaises(results.SchemaError):
+            results.validate(bad)
+        with self.assertRaises(results.SchemaError):
+            results.validate(dict(good, count="3"))
+        with self.assertRaises(results.SchemaError):
+            results.validate(dict(good, metric="latency"))
+
+    def test_write_load_table(self):
+        rows = [results.row_from_samples("a_row", "raw", 72, 1000, [1000, 2000, 3000], 1, metric="rtt"),
+                results.row_from_samples("b_row", "shm", 8, 0, [100], 0, metric="rtt_half")]
+        with tempfile.TemporaryDirectory() as d:
+            results.write_results(d, rows, {"k": 1}, [{"name": "c", "status": "skipped", "reason": "r"}])
+            doc = results.load_results(d)
+            self.assertEqual([r["name"] for r in doc["results"]], ["a_row", "b_row"])
+            self.assertEqual(doc["skipped"][0]["name"], "c")
+        t = results.format_table(rows)
+        self.assertIn("a_row", t)
+        self.assertIn("b2b", t)
+        self.assertIn("2.00", t)  # p50 2000 ns in us
+
+
+class ProgramTest(unittest.TestCase):
+    """Run the programs briefly; check their statistics against their own raw dump."""
+
+    def check_against_dump(self, row, dump, expect_count=None):
+        raw = results.load_raw(dump)
+        got = [ns for _, ns in raw if ns >= 0]
+        lost = sum(1 for _, ns in raw if ns < 0)
+        ref = results.row_from_samples(row["name"], row["transport"], row["payload_bytes"], row["rate_hz"],
+                                       got, lost)
+        for f in ("min_ns", "p50_ns", "p90_ns", "p99_ns", "p999_ns", "max_ns", "count", "lost"):
+            self.assertEqual(row[f], ref[f], f)
+        self.assertAlmostEqual(row["mean_ns"], ref["mean_ns"], delta=1.0)
+        if expect_count is not None:
+            self.assertEqual(row["count"] + row["lost"], expect_count)
+
+    def test_shm_modes(self):
+        exe = prog("shm_floor")
+        with tempfile.TemporaryDirectory() as d:
+            for mode, count in (("spin", 3000), ("futex", 300), ("eventfd", 300)):
+                dump = os.path.join(d, mode + ".tsv")
+                out = subprocess.run([exe, "--mode", mode, "--count", str(count), "--warmup", "10", "--half",
+                                      "--dump", dump], stdout=subprocess.PIPE, text=True, timeout=60, check=True)
+                row = results.parse_program_output(out.stdout)
+                self.assertEqual(row["metric"], "rtt_half")
+                self.assertEqual(row["lost"], 0)
+                self.assertGreater(row["min_ns"], 0)
+                self.check_against_dump(row, dump, count)
+
+    def test_bad_usage(self):
+        exe = prog("net_floor")
+        for args in (["--transport", "udp"], ["--transport", "tcp", "--role", "ping"],
+                     ["--transport", "raw", "--role", "ping"], ["--transport", "udp", "--role", "ping",
+                                                                "--payload", "99999"]):
+            self.assertEqual(subprocess.run([exe] + args, stderr=subprocess.DEVNULL).returncode, 2, args)
+        self.assertEqual(subprocess.run([prog("shm_floor"), "--mode", "x"], stderr=subprocess.DEVNULL).returncode, 2)
+
+    def _udp_pair(self, port, ping_args, echo_args=()):
+        exe = prog("net_floor")
+        echo = subprocess.Popen([exe, "--transport", "udp", "--role", "echo", "--bind", "127.0.0.1:%d" % port]
+                                + list(echo_args), stderr=subprocess.PIPE, text=True)
+        try:
+            ping = subprocess.run([exe, "--transport", "udp", "--role", "ping", "--peer", "127.0.0.1:%d" % port]
+                                  + ping_args, stdout=subprocess.PIPE, text=True, timeout=60)
+            return ping.returncode, ping.stdout
+        finally:
+            try:
+                echo.wait(timeout=3)  # exits on the ping's FIN (or its --echo-limit)
+            except subprocess.TimeoutExpired:
+                echo.kill()
+                echo.wait()
+            echo.stderr.close()
+
+    def test_udp_loopback_rtt(self):
+        with tempfile.TemporaryDirectory() as d:
+            dump = os.path.join(d, "u.tsv")
+            rc, out = self._udp_pair(free_udp_port(), ["--rate", "0", "--count", "500", "--warmup", "20",
+                                                       "--payload", "288", "--dump", dump])
+            self.assertEqual(rc, 0)
+            row = results.parse_program_output(out)
+            self.assertEqual((row["transport"], row["metric"], row["payload_bytes"]), ("udp", "rtt", 288))
+            self.assertEqual(row["lost"], 0)
+            self.check_against_dump(row, dump, 500)
+
+    def test_udp_loss_is_counted(self):
+        # The echo answers 10 warm-up + 100 measured pings, then exits: exactly 200 of
+        # the 300 measured must be lost (late answers cannot exist: there are none).
+        with tempfile.TemporaryDirectory() as d:
+            dump = os.path.join(d, "l.tsv")
+            rc, out = self._udp_pair(free_udp_port(), ["--rate", "2000", "--count", "300", "--warmup", "10",
+                                                       "--timeout-ms", "50", "--dump", dump],
+                                     echo_args=["--echo-limit", "110"])
+            self.assertEqual(rc, 0)
+            row = results.parse_program_output(out)
+            self.assertEqual((row["count"], row["lost"], row["sent"]), (100, 200, 310))
+            self.check_against_dump(row, dump, 300)
+            lost_seqs = [seq for seq, ns in results.load_raw(dump) if ns < 0]
+            self.assertEqual(lost_seqs, list(range(110, 310)))
+
+    def test_no_peer_fails(self):
+        exe = prog("net_floor")
+        cp = subprocess.run([exe, "--transport", "udp", "--role", "ping", "--peer", "127.0.0.1:%d" % free_udp_port(),
+                             "--start-wait-ms", "200", "--count", "10"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, timeout=30)
+        self.assertEqual(cp.returncode, 1)
+        self.assertEqual(cp.stdout, "")
+
+    def test_udp_oneway(self):
+        exe = prog("net_floor")
+        port = free_udp_port()
+        with tempfile.TemporaryDirectory() as d:
+            dump = os.path.join(d, "o.tsv")
+            common = ["--transport", "udp", "--rate", "2000", "--count", "400", "--warmup", "10", "--payload", "72"]
+            sink = subprocess.Popen([exe, "--role", "sink", "--bind", "127.0.0.1:%d" % port, "--dump", dump] + common,
+                                    stdout=subprocess.PIPE, text=True)
+            try:
+                src = subprocess.run([exe, "--role", "source", "--peer", "127.0.0.1:%d" % port] + common,
+                                     stderr=subprocess.PIPE, text=True, timeout=60)
+                out, _ = sink.communicate(timeout=30)
+            finally:
+                if sink.poll() is None:
+                    sink.kill()
+                    sink.wait()
+            self.assertEqual(src.returncode, 0)
+            self.assertEqual(sink.returncode, 0)
+            row = results.parse_program_output(out)
+            self.assertEqual(row["metric"], "one_way")
+            self.assertEqual(row["sent"], 410)
+            self.assertGreater(row["min_ns"], 0)
+            self.check_against_dump(row, dump, 400)
+
+    @unittest.skipUnless(os.geteuid() == 0, "network namespaces need root")
+    def test_raw_in_netns(self):
+        exe = prog("net_floor")
+        pair = procs.NetnsPair("ccbt%d" % (os.getpid() % 10000))
+        with pair:
+            echo = subprocess.Popen(pair.wrap("b", [exe, "--transport", "raw", "--role", "echo", "--if", "eth0"]),
+                                    stderr=subprocess.DEVNULL)
+            try:
+                cp = subprocess.run(pair.wrap("a", [exe, "--transport", "raw", "--role", "ping", "--if", "eth0",
+                                                    "--rate", "0", "--count", "300", "--payload", "8"]),
+                                    stdout=subprocess.PIPE, text=True, timeout=60)
+            finally:
+                try:
+                    echo.wait(timeout=3)
+                except subprocess.TimeoutExpired:
+                    echo.kill()
+                    echo.wait()
+        self.assertEqual(cp.returncode, 0)
+        row = results.parse_program_output(cp.stdout)
+        self.assertEqual((row["transport"], row["count"], row["lost"], row["wire_bytes"]), ("raw", 300, 0, 60))
+        # The namespaces are gone again.
+        names = subprocess.run(["ip", "netns", "list"], stdout=subprocess.PIPE, text=True).stdout
+        self.assertNotIn(pair.ns_a, names)
+
+
+class DriverTest(unittest.TestCase):
+    def test_smoke_subset(self):
+        if not BIN:
+            raise unittest.SkipTest("bench programs not built")
+        with tempfile.TemporaryDirectory() as d:
+            cp = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "bench-floors"), "--smoke",
+                                 "--only", "^shm_spin|^net_udp_rtt_b2b", "--build-dir", os.path.dirname(BIN),
+                                 "--no-plots", "--netns-prefix", "ccbd%d" % (os.getpid() % 10000), "--out", d],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+            self.assertEqual(cp.returncode, 0, cp.stderr)
+            doc = results.load_results(d)
+            names = [r["name"] for r in doc["results"]] + [s["name"] for s in doc["skipped"]]
+            self.assertIn("shm_spin_b2b_p8", names)
+            self.assertIn("net_udp_rtt_b2b_p8", names)
+            self.assertIn("shm_spin_b2b_p8", cp.stdout)
+            with open(os.path.join(d, "results.json")) as f:
+                self.assertIn("meta", json.load(f))
+            for r in doc["results"]:
+                self.assertTrue(os.path.exists(os.path.join(d, r["raw"])))
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -64,6 +64,7 @@ class Daemon {
   struct PeerRx {
     bool seen = false;
     uint32_t expected = 0;
+    uint64_t last_send_ns = 0;  // newest send time seen: a lower seq sent later = restart
   };
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);

@@ -38,8 +38,9 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   } else if (ahead < 0x80000000u) {
     ps.frames_lost.fetch_add(ahead, std::memory_order_relaxed);
     pr.expected = h.seq + 1;
-  } else if (pr.expected - h.seq > 1024) {
-    // Far behind: the peer restarted. Its value sequence numbers may restart too.
+  } else if (h.send_time_ns > pr.last_send_ns || !ps.alive.load(std::memory_order_relaxed)) {
+    // A lower seq sent later than anything seen (or after silence): the peer restarted.
+    // Its value sequence numbers may restart too.
     Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)",
         cfg_->nodes[h.sender].name.c_str(), h.seq, pr.expected);
     for (size_t i = 0; i < last_rx_seq_.size(); ++i)
@@ -48,6 +49,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   } else {
     ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
   }
+  if (h.send_time_ns > pr.last_send_ns) pr.last_send_ns = h.send_time_ns;
   ps.frames_rx.fetch_add(1, std::memory_order_relaxed);
   ps.last_seq.store(h.seq, std::memory_order_relaxed);
   ps.last_rx_ns.store(now, std::memory_order_release);

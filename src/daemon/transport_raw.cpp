@@ -38,12 +38,8 @@ ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
     if (sll.sll_pkttype == PACKET_OUTGOING) continue;  // our own frames, looped back
     if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
     memcpy(from->mac, sll.sll_addr, 6);
-    // Ethernet pads payloads to 46 bytes: trim padding after the declared frame length.
-    if (n >= static_cast<ssize_t>(wire::kHeaderSize) && n <= 46) {
-      size_t declared = wire::kHeaderSize + ((size_t{buf[26]} << 8) | buf[27]) +
-                        ((buf[5] & wire::kFlagAuth) ? wire::kAuthTagSize : 0);
-      if (declared < static_cast<size_t>(n)) n = static_cast<ssize_t>(declared);
-    }
+    // Ethernet pads payloads to 46 bytes: drop (zero) padding after the declared frame.
+    n = static_cast<ssize_t>(wire::TrimEthernetPadding(buf, static_cast<size_t>(n)));
     return n;
   }
 }

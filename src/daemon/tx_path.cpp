@@ -16,7 +16,7 @@ void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
   h.sender = static_cast<uint16_t>(self_);
   h.dest = static_cast<uint16_t>(peer);
   h.config_hash = cfg_->hash;
-  h.seq = p.seq++;
+  h.seq = p.seq;  // advanced only when the frame is really sent
   h.send_time_ns = now;
   p.writer.Begin(h);
   p.open = true;
@@ -26,8 +26,10 @@ void Daemon::FlushPeer(uint32_t peer) {
   PeerTx& p = peers_tx_[peer];
   if (!p.open) return;
   size_t len = p.writer.Finish();
-  int r = transport_.Send(p.addr, p.buf, len);
   p.open = false;
+  if (len == 0) return;  // nothing in it (a data frame is never empty)
+  p.seq++;
+  int r = transport_.Send(p.addr, p.buf, len);
   p.last_tx_ns = platform::MonotonicNs();  // also on failure: a dead link must not busy-loop
   if (r != 0) {
     Count(store::kSendErrors);

@@ -1,0 +1,278 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm-latency: a control-loop-shaped load and latency probe, app -> ccommd -> wire ->
+// ccommd -> app. Used by scripts/demo, scripts/bench and the QEMU tests.
+//
+// Each cycle (clock_nanosleep, absolute) the sender writes every --send signal with the
+// cycle number k as value, then ccomm_flush(): one frame per cycle. A receive thread
+// blocks in ccomm_wait() and records, for each cycle whose --recv signals have all
+// arrived, the latency:
+//   oneway: arrival - producer's write time (same clock: namespaces on one host)
+//   ping:   the peer runs --mode echo and sends k back; RTT/2 = (arrival - send of k)/2
+// Loss = cycles in the observed range that never arrived complete.
+#include <getopt.h>
+#include <inttypes.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "ccomm/ccomm.h"
+
+namespace {
+
+const char kUsage[] =
+    "Usage: ccomm-latency [OPTIONS]\n"
+    "Sends doubles at a fixed rate through ccomm and measures the latency of what comes back.\n"
+    "  -n, --node NAME        node to attach to (default $CCOMM_NODE / hostname)\n"
+    "  -r, --rate HZ          send rate (default 1000)\n"
+    "  -d, --duration SEC     how long to run (default 10)\n"
+    "  -m, --mode MODE        oneway (default), ping, or echo (reply to a ping peer)\n"
+    "      --send A,B,...     signals to write each cycle (default: doubles produced here)\n"
+    "      --recv A,B,...     signals to wait for (default: doubles consumed here)\n"
+    "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
+    "      --prio N           SCHED_FIFO priority for the send loop (needs CAP_SYS_NICE)\n"
+    "      --label TEXT       name in the JSON result\n"
+    "      --samples FILE     write every latency sample (ns) to FILE\n"
+    "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
+    "p999_ns,max_ns,mean_ns,count}.\n";
+
+struct Options {
+  const char* node = nullptr;
+  double rate = 1000, duration = 10, warmup = 0.5;
+  std::string mode = "oneway", label = "ccomm", samples_file;
+  std::string send, recv;
+  int prio = 0;
+};
+
+uint64_t Now() {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+std::vector<std::string> Split(const std::string& s) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= s.size()) {
+    size_t c = s.find(',', start);
+    std::string p = s.substr(start, c == std::string::npos ? std::string::npos : c - start);
+    if (!p.empty()) out.push_back(p);
+    if (c == std::string::npos) break;
+    start = c + 1;
+  }
+  return out;
+}
+
+constexpr size_t kHistory = 1 << 16;  // send times by cycle, for ping mode
+
+struct Shared {
+  ccomm_client* rx_client = nullptr;
+  ccomm_client* tx_client = nullptr;
+  std::vector<ccomm_signal> send, recv;
+  std::vector<uint64_t> send_time;  // [k % kHistory]
+  std::atomic<bool> stop{false};
+  std::atomic<uint64_t> sent{0};
+  bool ping = false, echo = false;
+  uint64_t warmup_until = 0;
+  std::vector<int64_t> samples;
+  uint64_t first_k = 0, last_k = 0, received = 0;
+  bool any = false;
+};
+
+void WriteAll(Shared* s, double k) {
+  for (ccomm_signal id : s->send) ccomm_write_double(s->tx_client, id, k);
+  ccomm_flush(s->tx_client);
+}
+
+void* Receiver(void* arg) {
+  Shared* s = static_cast<Shared*>(arg);
+  const size_t n = s->recv.size();
+  std::vector<uint64_t> last_seq(n, 0);
+  std::vector<double> got(n, -1);
+  std::vector<uint64_t> src(n, 0);
+  double last_complete = -1;
+  while (!s->stop.load(std::memory_order_relaxed)) {
+    ccomm_wait(s->rx_client, 50);
+    uint64_t now = Now();
+    bool changed = false;
+    for (size_t i = 0; i < n; ++i) {
+      double v;
+      ccomm_info info;
+      int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
+      if ((r == CCOMM_FRESH || r == CCOMM_STALE) && info.seq != last_seq[i]) {
+        last_seq[i] = info.seq;
+        got[i] = v;
+        src[i] = info.source_time_ns;
+        changed = true;
+      }
+    }
+    if (!changed || n == 0) continue;
+    double k = got[0];
+    bool complete = k > last_complete;
+    uint64_t latest_src = 0;
+    for (size_t i = 0; i < n && complete; ++i) {
+      complete = got[i] == k;
+      latest_src = std::max(latest_src, src[i]);
+    }
+    if (!complete) continue;
+    last_complete = k;
+    uint64_t kk = static_cast<uint64_t>(k);
+    if (s->echo) {
+      WriteAll(s, k);
+      continue;
+    }
+    if (now < s->warmup_until) continue;
+    int64_t lat;
+    if (s->ping) {
+      uint64_t t0 = s->send_time[kk % kHistory];
+      if (!t0) continue;
+      lat = static_cast<int64_t>(now - t0) / 2;
+    } else {
+      lat = static_cast<int64_t>(now - latest_src);
+    }
+    if (!s->any) s->first_k = kk;
+    s->any = true;
+    s->last_k = kk;
+    s->received++;
+    if (s->samples.size() < s->samples.capacity()) s->samples.push_back(lat);
+  }
+  return nullptr;
+}
+
+std::vector<ccomm_signal> Resolve(ccomm_client* c, const std::string& list, bool produced, const char* what) {
+  std::vector<ccomm_signal> out;
+  if (!list.empty()) {
+    for (const std::string& name : Split(list)) {
+      ccomm_signal id = ccomm_find(c, name.c_str());
+      if (id < 0) {
+        fprintf(stderr, "ccomm-latency: no signal '%s' (%s)\n", name.c_str(), what);
+        exit(2);
+      }
+      out.push_back(id);
+    }
+    return out;
+  }
+  for (int i = 0; i < ccomm_signal_count(c); ++i) {
+    ccomm_signal_desc d;
+    ccomm_describe(c, i, &d);
+    if (d.type != CCOMM_DOUBLE || d.count != 1 || d.is_event) continue;
+    bool here = d.produced_here != 0;
+    bool mine = strcmp(d.producer, ccomm_node_name(c)) == 0;
+    if (produced ? here : !mine) out.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  static const struct option kLong[] = {
+      {"node", required_argument, nullptr, 'n'},   {"rate", required_argument, nullptr, 'r'},
+      {"duration", required_argument, nullptr, 'd'}, {"mode", required_argument, nullptr, 'm'},
+      {"send", required_argument, nullptr, 'S'},   {"recv", required_argument, nullptr, 'R'},
+      {"warmup", required_argument, nullptr, 'W'}, {"prio", required_argument, nullptr, 'P'},
+      {"label", required_argument, nullptr, 'L'},  {"samples", required_argument, nullptr, 'F'},
+      {"help", no_argument, nullptr, 'h'},         {nullptr, 0, nullptr, 0}};
+  int ch;
+  while ((ch = getopt_long(argc, argv, "n:r:d:m:h", kLong, nullptr)) != -1) {
+    switch (ch) {
+      case 'n': o.node = optarg; break;
+      case 'r': o.rate = atof(optarg); break;
+      case 'd': o.duration = atof(optarg); break;
+      case 'm': o.mode = optarg; break;
+      case 'S': o.send = optarg; break;
+      case 'R': o.recv = optarg; break;
+      case 'W': o.warmup = atof(optarg); break;
+      case 'P': o.prio = atoi(optarg); break;
+      case 'L': o.label = optarg; break;
+      case 'F': o.samples_file = optarg; break;
+      case 'h': fputs(kUsage, stdout); return 0;
+      default: fputs(kUsage, stderr); return 2;
+    }
+  }
+  if (o.rate <= 0 || o.duration <= 0 || (o.mode != "oneway" && o.mode != "ping" && o.mode != "echo")) {
+    fputs(kUsage, stderr);
+    return 2;
+  }
+  Shared s;
+  int r = ccomm_open(o.node, CCOMM_OPEN_BATCH, &s.tx_client);
+  if (r == 0) r = ccomm_open(o.node, 0, &s.rx_client);
+  if (r != 0) {
+    fprintf(stderr, "ccomm-latency: cannot attach: %s\n", ccomm_strerror(r));
+    return 1;
+  }
+  s.send = Resolve(s.tx_client, o.send, true, "--send");
+  s.recv = Resolve(s.rx_client, o.recv, false, "--recv");
+  s.ping = o.mode == "ping";
+  s.echo = o.mode == "echo";
+  s.send_time.assign(kHistory, 0);
+  s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
+  mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort
+
+  uint64_t start = Now();
+  s.warmup_until = start + static_cast<uint64_t>(o.warmup * 1e9);
+  pthread_t rx;
+  pthread_create(&rx, nullptr, Receiver, &s);
+  if (o.prio > 0) {
+    struct sched_param sp = {};
+    sp.sched_priority = o.prio;
+    if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) != 0)
+      fprintf(stderr, "ccomm-latency: SCHED_FIFO refused; running SCHED_OTHER\n");
+  }
+  const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
+  const uint64_t end = start + static_cast<uint64_t>(o.duration * 1e9);
+  uint64_t next = start;
+  for (uint64_t k = 1;; ++k) {
+    next += period;
+    struct timespec ts = {static_cast<time_t>(next / 1000000000ull), static_cast<long>(next % 1000000000ull)};
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+    if (Now() >= end) break;
+    if (s.echo) continue;  // echo only answers, from the receive thread
+    s.send_time[k % kHistory] = Now();
+    WriteAll(&s, static_cast<double>(k));
+    s.sent.fetch_add(1, std::memory_order_relaxed);
+  }
+  // Let the last frames arrive.
+  struct timespec tail = {0, 200 * 1000 * 1000};
+  nanosleep(&tail, nullptr);
+  s.stop = true;
+  pthread_join(rx, nullptr);
+
+  std::vector<int64_t> v = s.samples;
+  std::sort(v.begin(), v.end());
+  auto pct = [&](double p) -> int64_t {
+    if (v.empty()) return -1;
+    size_t i = static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+    return v[std::min(i, v.size() - 1)];
+  };
+  double mean = 0;
+  for (int64_t x : v) mean += static_cast<double>(x);
+  if (!v.empty()) mean /= static_cast<double>(v.size());
+  uint64_t expected = s.any ? s.last_k - s.first_k + 1 : 0;
+  uint64_t lost = expected > s.received ? expected - s.received : 0;
+  if (!o.samples_file.empty()) {
+    if (FILE* f = fopen(o.samples_file.c_str(), "w")) {
+      for (int64_t x : s.samples) fprintf(f, "%" PRId64 "\n", x);
+      fclose(f);
+    }
+  }
+  printf("{\"label\":\"%s\",\"mode\":\"%s\",\"node\":\"%s\",\"rate_hz\":%.0f,\"send_signals\":%zu,"
+         "\"recv_signals\":%zu,\"sent\":%" PRIu64 ",\"received\":%" PRIu64 ",\"lost\":%" PRIu64
+         ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
+         ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu}\n",
+         o.label.c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
+         s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
+         v.empty() ? -1 : v.back(), mean, v.size());
+  ccomm_close(s.tx_client);
+  ccomm_close(s.rx_client);
+  return 0;
+}

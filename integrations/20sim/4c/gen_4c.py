@@ -2,9 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Generates the 20-sim 4C I/O component of one ccomm node from signals.xml.
 
-    gen_4c.py SIGNALS.XML NODE OUTDIR
+    gen_4c.py [--node NODE] SIGNALS.XML [NODE] OUTDIR
 
-writes to OUTDIR:
+(`ccomm [--node NODE] gen 20sim4c SIGNALS.XML OUTDIR` runs it.) Without a NODE the node
+is $CCOMM_NODE, else the hostname, as for ccommd. Writes to OUTDIR:
   ccomm_4c.h, ccomm_4c.c   ANSI C driver: one port per signal element of the node
   ccomm_4c_component.xml   the component and its ports for the target configuration
   ccomm_4c_ports.txt       the port list, for people
@@ -459,15 +460,30 @@ const char* ccomm4c_output_name(int port) {{
 
 
 def main(argv: list[str]) -> int:
-    if len(argv) != 4 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip(), file=sys.stderr if len(argv) != 2 else sys.stdout)
-        return 0 if len(argv) == 2 else 2
+    import argparse
+    import os
+    import socket
+
+    ap = argparse.ArgumentParser(prog="gen_4c.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--node", help="node to generate for (default: $CCOMM_NODE, else hostname)")
+    ap.add_argument("args", nargs="+", metavar="SIGNALS.XML [NODE] OUTDIR")
+    a = ap.parse_args(argv[1:])
+    if len(a.args) == 3:
+        config, node, outdir = a.args
+        if a.node and a.node != node:
+            ap.error(f"--node {a.node} and NODE {node} disagree")
+    elif len(a.args) == 2:
+        config, outdir = a.args
+        node = a.node or os.environ.get("CCOMM_NODE") or socket.gethostname()
+    else:
+        ap.error("expected SIGNALS.XML [NODE] OUTDIR")
     try:
-        generate(Path(argv[1]), argv[2], Path(argv[3]))
+        generate(Path(config), node, Path(outdir))
     except (ConfigError, OSError) as e:
         print(f"gen_4c: {e}", file=sys.stderr)
         return 2
-    print(f"gen_4c: wrote ccomm_4c.c, ccomm_4c.h, ccomm_4c_component.xml, ccomm_4c_ports.txt to {argv[3]}")
+    print(f"gen_4c: node {node}: wrote ccomm_4c.c, ccomm_4c.h, ccomm_4c_component.xml, "
+          f"ccomm_4c_ports.txt to {outdir}")
     return 0
 
 

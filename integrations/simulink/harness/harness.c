@@ -6,7 +6,7 @@
  * mdlTerminate; mdlRTW for code generation) against a running ccommd, and checks what
  * the blocks output. Usage: simulink_harness NODE (ccommd running harness/signals.xml).
  */
-#define _POSIX_C_SOURCE 200809L
+#define _POSIX_C_SOURCE 200809L /* setenv, nanosleep */
 #define S_FUNCTION_NAME harness
 #define S_FUNCTION_LEVEL 2
 #include <ccomm/ccomm.h>
@@ -237,6 +237,8 @@ static void test_codegen_build(void) {
 int main(int argc, char** argv) {
   ccomm_client* c = NULL;
   node = argc > 1 ? argv[1] : "sim";
+  /* Blocks with node '' attach to $CCOMM_NODE: point it at the test node. */
+  setenv("CCOMM_NODE", node, 1);
   /* Wait for ccommd's segment (started in parallel by the test script). */
   for (int i = 0; i < 200 && ccomm_open(node, 0, &c) != 0; i++) sleep_ms(50);
   if (!c) {

@@ -61,11 +61,11 @@ class CcommTest(OERuntimeTestCase):
         # echo subscribes first (and must see exactly one new value), then pub writes it.
         value = '42.125'
         # busybox may lack timeout(1): a background sleeper kills a hung echo instead
-        cmd = ('ccomm echo {n} --count 1 > /tmp/ccomm-echo.out 2>&1 & e=$!; '
+        cmd = ('o=$(mktemp); ccomm echo {n} --count 1 > $o 2>&1 & e=$!; '
                '(sleep 15; kill $e) >/dev/null 2>&1 & w=$!; '
                'sleep 1; ccomm pub {n} {v}; pub=$?; '
                'wait $e; erc=$?; kill $w 2>/dev/null; '
-               'echo "pub-rc=$pub echo-rc=$erc"; cat /tmp/ccomm-echo.out').format(n=name, v=value)
+               'echo "pub-rc=$pub echo-rc=$erc"; cat $o; rm -f $o').format(n=name, v=value)
         status, output = self._run(cmd, timeout=40)
         self.assertIn('pub-rc=0', output, msg='ccomm pub failed:\n%s' % output)
         self.assertIn('echo-rc=0', output, msg='ccomm echo did not see one update:\n%s' % output)

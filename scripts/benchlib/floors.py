@@ -37,7 +37,7 @@ class Case:
     def est_seconds(self):
         if self.rate:
             return self.count / self.rate
-        per = {"shm": 60e-6, "net": 40e-6, "lcm": 120e-6, "iox": 30e-6}[self.kind]
+        per = {"shm": 60e-6, "net": 40e-6, "lcm": 120e-6, "iox": 30e-6}.get(self.kind, 100e-6)
         if self.opts.get("mode") == "spin" or self.opts.get("wait") == "spin":
             per = 1e-6
         return self.count * per
@@ -326,6 +326,7 @@ def run_iox(ctx, case):
     return row
 
 
+# kind -> runner(ctx, case) returning a schema row; scripts/bench adds its ccomm kinds here.
 RUNNERS = {"shm": run_shm, "net": run_net, "lcm": run_lcm, "iox": run_iox}
 
 

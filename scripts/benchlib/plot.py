@@ -54,13 +54,16 @@ def plots(outdir, rows=None):
         if not series:
             continue
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(15, 6))
-        for r, v in series:
+        cmap = plt.get_cmap("tab20")
+        for k, (r, v) in enumerate(series):
             n = len(v)
             x = [ns / 1000.0 for ns in v]
             y = [(i + 1) / n for i in range(n)]
-            ax1.plot(x, y, label=_label(r), linewidth=1)
+            # 20 distinct colours, then the same with dashes: no two rows look alike.
+            style = {"color": cmap(k % 20), "linestyle": "-" if k < 20 else "--", "linewidth": 1}
+            ax1.plot(x, y, label=_label(r), **style)
             # Survival: P(latency > x); 1/n floor so the last point stays on a log axis.
-            ax2.plot(x, [max(1.0 - yy, 1.0 / n) for yy in y], linewidth=1)
+            ax2.plot(x, [max(1.0 - yy, 1.0 / n) for yy in y], **style)
         for ax in (ax1, ax2):
             ax.set_xscale("log")
             ax.set_xlabel("latency [µs]")

@@ -10,6 +10,7 @@ a row belongs to), "raw" (raw-sample file relative to the output directory), "no
 import json
 import math
 import os
+import shutil
 
 SCHEMA_FIELDS = (
     "name", "transport", "payload_bytes", "rate_hz",
@@ -143,3 +144,41 @@ def format_table(rows):
         if j == 0:
             out.append("  ".join("-" * w for w in widths))
     return "\n".join(out)
+
+
+def load_rows(path):
+    """Rows from a results.json (or its directory), or from a file of JSON lines as the
+    programs print them. Each row's "raw" is made absolute so it can be copied."""
+    if os.path.isdir(path) or path.endswith("results.json"):
+        doc = load_results(path)
+        base = path if os.path.isdir(path) else os.path.dirname(path)
+        rows = doc.get("results", [])
+    else:
+        base = os.path.dirname(path)
+        rows = []
+        with open(path) as f:
+            for line in f:
+                line = line.strip()
+                if line.startswith("{"):
+                    rows.append(validate(json.loads(line)))
+    for r in rows:
+        if r.get("raw") and not os.path.isabs(r["raw"]):
+            r["raw"] = os.path.join(os.path.abspath(base), r["raw"])
+    return rows
+
+
+def adopt_rows(rows, outdir):
+    """Make rows from elsewhere part of outdir: raw files copied under outdir/raw/."""
+    os.makedirs(os.path.join(outdir, "raw"), exist_ok=True)
+    for r in rows:
+        src = r.get("raw")
+        if src and os.path.isabs(src):
+            rel = os.path.join("raw", r["name"] + ".tsv")
+            dst = os.path.join(outdir, rel)
+            if os.path.exists(src):
+                if os.path.abspath(src) != os.path.abspath(dst):
+                    shutil.copyfile(src, dst)
+                r["raw"] = rel
+            else:
+                del r["raw"]
+    return rows

@@ -89,6 +89,18 @@ class StatsTest(unittest.TestCase):
         self.assertIn("2.00", t)  # p50 2000 ns in us
 
 
+    def test_merge_rows(self):
+        with tempfile.TemporaryDirectory() as src, tempfile.TemporaryDirectory() as out:
+            with open(os.path.join(src, "x.tsv"), "w") as f:
+                f.write("0\t100\n1\t-1\n")
+            row = results.row_from_samples("ccomm_x", "raw", 8, 1000, [100], 1, group="net", raw="x.tsv")
+            with open(os.path.join(src, "rows.jsonl"), "w") as f:
+                f.write("noise\n" + json.dumps(row) + "\n")
+            rows = results.adopt_rows(results.load_rows(os.path.join(src, "rows.jsonl")), out)
+            self.assertEqual(rows[0]["raw"], os.path.join("raw", "ccomm_x.tsv"))
+            self.assertEqual(results.load_raw(os.path.join(out, rows[0]["raw"])), [(0, 100), (1, -1)])
+
+
 class ProgramTest(unittest.TestCase):
     """Run the programs briefly; check their statistics against their own raw dump."""
 

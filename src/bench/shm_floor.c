@@ -19,6 +19,7 @@
 #include <poll.h>
 #include <stdatomic.h>
 #include <sys/eventfd.h>
+#include <sys/prctl.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 
@@ -247,10 +248,15 @@ int main(int argc, char **argv)
     bench_samples s;
     bench_samples_init(&s, (size_t)total);
 
+    pid_t parent = getpid();
     pid_t child = fork();
     if (child < 0)
         bench_die("fork: %s", strerror(errno));
     if (child == 0) {
+        /* Die with the parent: a blocked futex/eventfd waiter would otherwise stay forever. */
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent)
+            _exit(BENCH_EXIT_FAIL);
         bench_rt_setup(o.cpu[1], o.prio, !o.no_mlock);
         pong_loop(a, m, (size_t)o.payload, efd_req, efd_rep, same_cpu);
         _exit(0);

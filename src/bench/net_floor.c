@@ -68,8 +68,11 @@ static void usage(FILE *f)
             "  --idle-ms MS       echo/sink: exit after MS without traffic once started (default 0 = never\n"
             "                     for echo, 2000 for sink)\n"
             "  --start-wait-ms MS ping/source: how long to probe for the peer (default 10000)\n" BENCH_COMMON_HELP
+            "Defaults: --rate 1000 --count 10000 --warmup 100 --payload 8 --timeout-ms 1000.\n"
+            "Every message carries a %u-byte bench header (magic, type, sequence, send time) before\n"
+            "the payload; raw frames are padded to the 60-byte Ethernet minimum.\n"
             "Exit codes: 0 ok, 1 failure, 2 usage, 4 skipped (no permission for raw sockets).\n",
-            DEFAULT_UDP_PORT);
+            DEFAULT_UDP_PORT, BENCH_HDR_SIZE);
 }
 
 static int parse_mac(const char *s, unsigned char mac[6])

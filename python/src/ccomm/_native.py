@@ -1,0 +1,129 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Finds and loads libccomm.so and declares the C API for ctypes."""
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+from pathlib import Path
+from typing import Mapping, Optional, Sequence
+
+LIB_NAMES = ("libccomm.so.0", "libccomm.so")
+
+
+class LibraryNotFoundError(OSError):
+    """libccomm.so was not found; the message lists where it was looked for."""
+
+
+class Info(ctypes.Structure):
+    _fields_ = [
+        ("status", ctypes.c_int32),
+        ("flags", ctypes.c_uint32),
+        ("seq", ctypes.c_uint64),
+        ("age_ns", ctypes.c_int64),
+        ("source_time_ns", ctypes.c_uint64),
+        ("lost", ctypes.c_uint64),
+    ]
+
+
+class SignalDesc(ctypes.Structure):
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("type", ctypes.c_int32),
+        ("count", ctypes.c_uint32),
+        ("value_bytes", ctypes.c_uint32),
+        ("is_event", ctypes.c_int32),
+        ("produced_here", ctypes.c_int32),
+        ("stale_after_ms", ctypes.c_uint32),
+        ("producer", ctypes.c_char_p),
+    ]
+
+
+def _repo_roots(starts: Sequence[Path]) -> list[Path]:
+    """Directories above `starts` that look like a ccomm source tree."""
+    roots: list[Path] = []
+    for start in starts:
+        for d in [start, *start.parents]:
+            if (d / "src" / "include" / "ccomm" / "ccomm.h").is_file() and d not in roots:
+                roots.append(d)
+                break
+    return roots
+
+
+def candidates(env: Mapping[str, str], starts: Sequence[Path]) -> list[Path]:
+    """Library paths to try, in order: $CCOMM_LIBRARY, $CCOMM_BUILD_DIR/lib, the newest
+    build*/lib of an enclosing source tree. (The system search comes after these.)"""
+    out: list[Path] = []
+    if env.get("CCOMM_LIBRARY"):
+        return [Path(env["CCOMM_LIBRARY"])]
+    if env.get("CCOMM_BUILD_DIR"):
+        out += [Path(env["CCOMM_BUILD_DIR"]) / "lib" / n for n in LIB_NAMES]
+    builds: list[Path] = []
+    for root in _repo_roots(starts):
+        for b in root.glob("build*/lib"):
+            if any((b / n).is_file() for n in LIB_NAMES):
+                builds.append(b)
+    builds.sort(key=lambda b: max((b / n).stat().st_mtime for n in LIB_NAMES if (b / n).is_file()),
+                reverse=True)
+    for b in builds:
+        out += [b / n for n in LIB_NAMES]
+    return out
+
+
+def find_library(env: Optional[Mapping[str, str]] = None,
+                 starts: Optional[Sequence[Path]] = None) -> str:
+    """Path (or soname) of libccomm to load; raises LibraryNotFoundError."""
+    env = os.environ if env is None else env
+    starts = [Path(__file__).resolve().parent, Path.cwd()] if starts is None else starts
+    tried = candidates(env, starts)
+    for p in tried:
+        if p.is_file():
+            return str(p)
+    if env.get("CCOMM_LIBRARY"):
+        raise LibraryNotFoundError(f"CCOMM_LIBRARY={env['CCOMM_LIBRARY']} does not exist")
+    system = ctypes.util.find_library("ccomm")
+    if system:
+        return system
+    where = ", ".join(str(p) for p in tried) or "no build directory"
+    raise LibraryNotFoundError(
+        f"libccomm.so not found (tried {where}, then the system library path). "
+        "Set CCOMM_LIBRARY to the library or CCOMM_BUILD_DIR to a ccomm build directory.")
+
+
+_lib: Optional[ctypes.CDLL] = None
+
+
+def lib() -> ctypes.CDLL:
+    """The loaded library, declared; loaded on first use so `import ccomm` never fails."""
+    global _lib
+    if _lib is None:
+        _lib = _declare(ctypes.CDLL(find_library()))
+    return _lib
+
+
+def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
+    vp, cp, i32, u32 = ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int32, ctypes.c_uint32
+    L.ccomm_open.argtypes = [cp, u32, ctypes.POINTER(vp)]
+    L.ccomm_open.restype = ctypes.c_int
+    L.ccomm_close.argtypes = [vp]
+    L.ccomm_close.restype = None
+    L.ccomm_strerror.argtypes = [ctypes.c_int]
+    L.ccomm_strerror.restype = cp
+    L.ccomm_find.argtypes = [vp, cp]
+    L.ccomm_find.restype = i32
+    L.ccomm_signal_count.argtypes = [vp]
+    L.ccomm_signal_count.restype = ctypes.c_int
+    L.ccomm_describe.argtypes = [vp, i32, ctypes.POINTER(SignalDesc)]
+    L.ccomm_describe.restype = ctypes.c_int
+    L.ccomm_node_name.argtypes = [vp]
+    L.ccomm_node_name.restype = cp
+    L.ccomm_read.argtypes = [vp, i32, vp, ctypes.c_size_t, ctypes.POINTER(Info)]
+    L.ccomm_read.restype = ctypes.c_int
+    L.ccomm_write.argtypes = [vp, i32, vp, ctypes.c_size_t]
+    L.ccomm_write.restype = ctypes.c_int
+    # ctypes releases the GIL during foreign calls: other threads run while this blocks.
+    L.ccomm_wait.argtypes = [vp, ctypes.c_int]
+    L.ccomm_wait.restype = ctypes.c_int
+    L.ccomm_daemon_alive.argtypes = [vp]
+    L.ccomm_daemon_alive.restype = ctypes.c_int
+    return L

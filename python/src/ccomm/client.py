@@ -1,0 +1,321 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Client, Signal and Reading: typed access to one node's ccomm signals."""
+from __future__ import annotations
+
+import ctypes
+import enum
+import math
+from dataclasses import dataclass
+from typing import Any, Dict, Iterator, List, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _native
+
+Scalar = Union[bool, int, float]
+Value = Union[Scalar, "npt.NDArray[Any]"]
+ValueLike = Union[Scalar, "npt.ArrayLike"]
+
+
+class Status(enum.IntEnum):
+    """What a read says about the value (ccomm_status)."""
+
+    FRESH = 0  #: younger than the signal's stale_after_ms
+    STALE = 1  #: older than stale_after_ms (the safe value if one is configured)
+    NEVER = 2  #: nothing received since the node's segment was created
+    EMPTY = 3  #: event signal: no new event since the last read
+
+
+class SignalType(enum.IntEnum):
+    BOOL = 1
+    INT32 = 2
+    UINT32 = 3
+    INT64 = 4
+    FLOAT = 5
+    DOUBLE = 6
+
+
+_DTYPES: Dict[SignalType, "np.dtype[Any]"] = {
+    SignalType.BOOL: np.dtype(np.bool_),
+    SignalType.INT32: np.dtype(np.int32),
+    SignalType.UINT32: np.dtype(np.uint32),
+    SignalType.INT64: np.dtype(np.int64),
+    SignalType.FLOAT: np.dtype(np.float32),
+    SignalType.DOUBLE: np.dtype(np.float64),
+}
+
+_SAFE_VALUE = 0x1  # CCOMM_INFO_SAFE_VALUE
+_NO_DOORBELL = 0x1  # CCOMM_OPEN_NO_DOORBELL
+
+
+class CcommError(Exception):
+    """A ccomm call failed; `code` is the ccomm error (< 0)."""
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+class InvalidArgumentError(CcommError, ValueError):
+    """CCOMM_E_INVAL: bad argument."""
+
+
+class NotFoundError(CcommError, LookupError):
+    """CCOMM_E_NOENT: no such signal, or no segment (is ccommd running?)."""
+
+
+class TypeMismatchError(CcommError, TypeError):
+    """CCOMM_E_TYPE: the value does not match the signal's type or size."""
+
+
+class NotProducerError(CcommError, PermissionError):
+    """CCOMM_E_PERM: this node does not produce the signal."""
+
+
+class QueueFullError(CcommError):
+    """CCOMM_E_FULL: the event queue is full (ccommd is not forwarding)."""
+
+
+class BusyError(CcommError):
+    """CCOMM_E_BUSY: writers raced for every slot; retry next cycle."""
+
+
+class SystemCallError(CcommError, OSError):
+    """CCOMM_E_SYS: an OS call failed at open."""
+
+
+class VersionError(CcommError):
+    """CCOMM_E_VERSION: the segment has another layout version than the library."""
+
+
+class RetiredError(CcommError):
+    """CCOMM_E_RETIRED: ccommd replaced the segment (new configuration): reopen."""
+
+
+_ERRORS = {-1: InvalidArgumentError, -2: NotFoundError, -3: TypeMismatchError,
+           -4: NotProducerError, -5: QueueFullError, -6: BusyError, -7: SystemCallError,
+           -8: VersionError, -9: RetiredError}
+
+
+def _check(code: int, what: str) -> int:
+    if code < 0:
+        msg = _native.lib().ccomm_strerror(code)
+        text = msg.decode() if msg else f"error {code}"
+        raise _ERRORS.get(code, CcommError)(code, f"{what}: {text}")
+    return code
+
+
+@dataclass(frozen=True)
+class SignalInfo:
+    """Static description of a signal (from signals.xml, as ccommd loaded it)."""
+
+    id: int
+    name: str
+    type: SignalType
+    count: int  #: array length; 1 = scalar
+    value_bytes: int
+    is_event: bool
+    produced_here: bool  #: this node may write it
+    stale_after_ms: int  #: 0 = never stale
+    producer: str
+
+    @property
+    def dtype(self) -> "np.dtype[Any]":
+        return _DTYPES[self.type]
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One read: the value and what ccomm knows about it."""
+
+    value: Optional[Value]  #: scalar for count 1, numpy array otherwise; None if EMPTY
+    status: Status
+    seq: int  #: producer's sequence number (0 = never)
+    age_ns: Optional[int]  #: since the value reached this node; None if never
+    source_time_ns: int  #: producer's CLOCK_MONOTONIC when it wrote the value
+    lost: int  #: values/events of this signal known lost so far
+    safe_value: bool  #: the value is the configured safe value
+
+    @property
+    def fresh(self) -> bool:
+        return self.status == Status.FRESH
+
+
+class Signal:
+    """A signal of the client's node. Get one with Client.signal(name)."""
+
+    def __init__(self, client: "Client", info: SignalInfo) -> None:
+        self._client = client
+        self.info = info
+        # One buffer per signal, reused by every read and write (no allocation in C).
+        self._buf = (ctypes.c_ubyte * info.value_bytes)()
+        self._view: npt.NDArray[Any] = np.frombuffer(memoryview(self._buf), dtype=info.dtype,
+                                                     count=info.count)
+        self._cinfo = _native.Info()
+
+    @property
+    def name(self) -> str:
+        return self.info.name
+
+    def __repr__(self) -> str:
+        i = self.info
+        shape = f"[{i.count}]" if i.count != 1 else ""
+        return f"<Signal {i.name} {i.type.name.lower()}{shape} {'event' if i.is_event else 'state'}>"
+
+    def _read_raw(self) -> Status:
+        r = _native.lib().ccomm_read(self._client._handle(), self.info.id, self._buf,
+                                     self.info.value_bytes, ctypes.byref(self._cinfo))
+        status = Status(_check(r, f"read {self.info.name}"))
+        if status == Status.NEVER and not self._cinfo.flags & _SAFE_VALUE:
+            ctypes.memset(self._buf, 0, self.info.value_bytes)
+        return status
+
+    def _reading(self, status: Status, value: Optional[Value]) -> Reading:
+        ci = self._cinfo
+        if status == Status.EMPTY:
+            return Reading(None, status, 0, None, 0, int(ci.lost), False)
+        return Reading(value, status, int(ci.seq), None if ci.age_ns < 0 else int(ci.age_ns),
+                       int(ci.source_time_ns), int(ci.lost), bool(ci.flags & _SAFE_VALUE))
+
+    def read(self) -> Reading:
+        """State signal: the current value. Event signal: the next event, or EMPTY.
+        Never-received values are 0 unless a safe value is configured."""
+        self._cinfo.flags = 0
+        status = self._read_raw()
+        if status == Status.EMPTY:
+            return self._reading(status, None)
+        value: Value
+        if self.info.count == 1:
+            value = self._view[0].item()
+        else:
+            value = self._view.copy()
+        return self._reading(status, value)
+
+    def read_into(self, out: npt.NDArray[Any]) -> Reading:
+        """Reads into `out` (shape (count,), the signal's dtype), allocating no array.
+        The Reading's value is `out` (None for EMPTY; `out` then keeps its contents)."""
+        if out.shape != (self.info.count,) or out.dtype != self.info.dtype:
+            raise ValueError(f"{self.info.name}: out must have shape ({self.info.count},) and dtype "
+                             f"{self.info.dtype}, not {out.shape} {out.dtype}")
+        status = self._read_raw()
+        if status == Status.EMPTY:
+            return self._reading(status, None)
+        out[...] = self._view
+        return self._reading(status, out)
+
+    def write(self, value: ValueLike) -> None:
+        """Writes a value this node produces: a scalar for count 1, else `count` values
+        (or one value for every element). Integers must be integral and in range."""
+        i = self.info
+        arr = np.asarray(value)
+        if arr.ndim > 1 or (arr.ndim == 1 and arr.size not in (1, i.count)) or arr.size == 0:
+            raise ValueError(f"{i.name}: expected {i.count} value(s), got shape {arr.shape}")
+        if arr.dtype.kind not in "biuf":
+            raise TypeError(f"{i.name}: cannot write {arr.dtype} values to a {i.type.name.lower()} signal")
+        if i.dtype.kind in "iu" or i.dtype.kind == "b":
+            if arr.dtype.kind == "f" and not np.all(np.isfinite(arr) & (arr == np.round(arr))):
+                raise ValueError(f"{i.name}: {i.type.name.lower()} signal needs integral values, got {value!r}")
+            if i.dtype.kind == "b":
+                if not np.all((arr == 0) | (arr == 1)):
+                    raise ValueError(f"{i.name}: bool signal needs 0/1 or False/True, got {value!r}")
+            else:
+                info = np.iinfo(i.dtype)
+                as_float = arr.astype(np.float64) if arr.dtype.kind == "f" else None
+                lo, hi = (as_float.min(), as_float.max()) if as_float is not None else (int(arr.min()), int(arr.max()))
+                if lo < info.min or hi > info.max:
+                    raise OverflowError(f"{i.name}: value out of range for {i.type.name.lower()}: {value!r}")
+        self._view[...] = arr.astype(i.dtype)
+        r = _native.lib().ccomm_write(self._client._handle(), i.id, self._buf, i.value_bytes)
+        _check(r, f"write {i.name}")
+
+
+class Client:
+    """Attached to one node's ccommd segment. Use one Client per thread (ccomm handles
+    are not shared between threads). Closes on exit of a `with` block."""
+
+    def __init__(self, node: Optional[str] = None, *, no_doorbell: bool = False) -> None:
+        L = _native.lib()
+        h = ctypes.c_void_p()
+        r = L.ccomm_open(node.encode() if node is not None else None,
+                         _NO_DOORBELL if no_doorbell else 0, ctypes.byref(h))
+        _check(r, f"open node {node if node is not None else '(default)'}")
+        self._h: Optional[int] = h.value
+        self._signals: Dict[str, Signal] = {}
+
+    def _handle(self) -> int:
+        if self._h is None:
+            raise ValueError("ccomm client is closed")
+        return self._h
+
+    @property
+    def node(self) -> str:
+        n: Optional[bytes] = _native.lib().ccomm_node_name(self._handle())
+        return n.decode() if n else ""
+
+    @property
+    def closed(self) -> bool:
+        return self._h is None
+
+    def close(self) -> None:
+        if self._h is not None:
+            _native.lib().ccomm_close(self._h)
+            self._h = None
+
+    def __enter__(self) -> "Client":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def _describe(self, sid: int) -> SignalInfo:
+        d = _native.SignalDesc()
+        _check(_native.lib().ccomm_describe(self._handle(), sid, ctypes.byref(d)), f"describe {sid}")
+        return SignalInfo(id=sid, name=(d.name or b"").decode(), type=SignalType(d.type),
+                          count=int(d.count), value_bytes=int(d.value_bytes),
+                          is_event=bool(d.is_event), produced_here=bool(d.produced_here),
+                          stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode())
+
+    def signals(self) -> List[SignalInfo]:
+        """Every signal of the system, in configuration order."""
+        n = _check(_native.lib().ccomm_signal_count(self._handle()), "signal count")
+        return [self._describe(i) for i in range(n)]
+
+    def signal(self, name: str) -> Signal:
+        """The signal called `name` (raises NotFoundError)."""
+        s = self._signals.get(name)
+        if s is None:
+            sid = _native.lib().ccomm_find(self._handle(), name.encode())
+            _check(sid, f"signal {name!r} on node {self.node}")
+            s = Signal(self, self._describe(sid))
+            self._signals[name] = s
+        return s
+
+    def __getitem__(self, name: str) -> Signal:
+        return self.signal(name)
+
+    def __iter__(self) -> Iterator[SignalInfo]:
+        return iter(self.signals())
+
+    def read(self, name: str) -> Reading:
+        return self.signal(name).read()
+
+    def write(self, name: str, value: ValueLike) -> None:
+        self.signal(name).write(value)
+
+    def wait(self, timeout: Optional[float] = None) -> bool:
+        """Blocks until a signal of this node changes (True) or `timeout` seconds pass
+        (False); None waits forever. Releases the GIL while waiting."""
+        ms = -1 if timeout is None else max(0, int(math.ceil(timeout * 1000.0)))
+        return _check(_native.lib().ccomm_wait(self._handle(), ms), "wait") == 1
+
+    @property
+    def daemon_alive(self) -> bool:
+        """ccommd updated its heartbeat within the last second."""
+        return bool(_native.lib().ccomm_daemon_alive(self._handle()))

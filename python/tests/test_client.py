@@ -1,0 +1,180 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The Python binding against a real ccommd (see conftest.py)."""
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccomm
+from ccomm import Client, Status, SignalType
+
+
+def test_open_and_describe(client: Client) -> None:
+    assert client.node == "pytest"
+    assert client.daemon_alive
+    infos = {s.name: s for s in client.signals()}
+    assert list(infos)[:3] == ["d", "f", "i32"]
+    assert infos["i32"].type == SignalType.INT32 and infos["i32"].count == 3
+    assert infos["i32"].dtype == np.int32 and infos["i32"].value_bytes == 12
+    assert infos["ev"].is_event and not infos["d"].is_event
+    assert infos["d"].stale_after_ms == 300 and infos["d"].produced_here
+    assert infos["remote_x"].producer == "remote" and not infos["remote_x"].produced_here
+    assert repr(client["i32"]) == "<Signal i32 int32[3] state>"
+
+
+def test_unknown_node_and_signal(client: Client) -> None:
+    with pytest.raises(ccomm.NotFoundError):
+        Client("no-such-node")
+    with pytest.raises(ccomm.NotFoundError) as e:
+        client.signal("nope")
+    assert isinstance(e.value, LookupError) and e.value.code == -2
+
+
+def test_scalar_roundtrip_and_metadata(client: Client) -> None:
+    s = client.signal("d")
+    before = s.read().seq
+    t0 = time.monotonic_ns()
+    s.write(2.5)
+    r = s.read()
+    assert r.value == 2.5 and isinstance(r.value, float)
+    assert r.status == Status.FRESH and r.fresh and not r.safe_value
+    assert r.seq == before + 1
+    assert r.age_ns is not None and 0 <= r.age_ns < 1_000_000_000  # generous: CI machines are busy
+    assert abs(r.source_time_ns - t0) < 1_000_000_000
+    s.write(-7)
+    assert s.read().value == -7.0 and s.read().seq == before + 2
+
+
+def test_stale_gives_safe_value(client: Client) -> None:
+    s = client.signal("d")
+    s.write(3.0)
+    assert s.read().value == 3.0
+    time.sleep(0.7)  # stale_after_ms = 300
+    r = s.read()
+    assert r.status == Status.STALE and r.safe_value and r.value == -1.5
+
+
+def test_types(client: Client) -> None:
+    client.write("f", 0.25)
+    assert client.read("f").value == 0.25
+    client.write("u32", 4_000_000_000)
+    assert client.read("u32").value == 4_000_000_000
+    client.write("i64", -(2**40))
+    assert client.read("i64").value == -(2**40)
+    client.write("flag", True)
+    r = client.read("flag")
+    assert r.value is True
+    client.write("flag", 0)
+    assert client.read("flag").value is False
+
+
+def test_arrays_numpy(client: Client) -> None:
+    s = client.signal("i32")
+    s.write([1, -2, 3])
+    r = s.read()
+    assert isinstance(r.value, np.ndarray) and r.value.dtype == np.int32
+    assert r.value.tolist() == [1, -2, 3]
+    s.write(np.array([4.0, 5.0, 6.0]))  # integral floats are fine
+    out = np.zeros(3, dtype=np.int32)
+    r2 = s.read_into(out)
+    assert r2.value is out and out.tolist() == [4, 5, 6]
+    s.write(9)  # one value for every element
+    assert s.read().value.tolist() == [9, 9, 9]  # type: ignore[union-attr]
+    v = client.signal("vec")
+    v.write(np.linspace(0.0, 1.0, 4))
+    assert np.allclose(v.read().value, [0, 1 / 3, 2 / 3, 1])  # type: ignore[arg-type]
+    # The returned array is a copy: later reads do not change it.
+    a = v.read().value
+    v.write([7, 7, 7, 7])
+    assert np.allclose(a, [0, 1 / 3, 2 / 3, 1])  # type: ignore[arg-type]
+
+
+def test_write_checks(client: Client) -> None:
+    with pytest.raises(ValueError):
+        client.write("i32", [1, 2])  # wrong length
+    with pytest.raises(ValueError):
+        client.write("i32", [1.5, 2, 3])  # not integral
+    with pytest.raises(OverflowError):
+        client.write("i32", [2**31, 0, 0])
+    with pytest.raises(OverflowError):
+        client.write("u32", -1)
+    with pytest.raises(ValueError):
+        client.write("flag", 2)
+    with pytest.raises(TypeError):
+        client.write("d", "1.0")
+    with pytest.raises(ValueError):
+        client.signal("i32").read_into(np.zeros(3, dtype=np.int64))
+    with pytest.raises(ccomm.NotProducerError) as e:
+        client.write("remote_x", 1.0)
+    assert e.value.code == -4
+
+
+def test_never_received(client: Client) -> None:
+    r = client.read("remote_x")
+    assert r.status == Status.NEVER and r.value == 0.0 and r.seq == 0 and r.age_ns is None
+
+
+def test_events_are_queued(client: Client, node: str) -> None:
+    with Client(node) as reader:
+        ev = reader.signal("ev")
+        while ev.read().status != Status.EMPTY:  # drain what earlier tests left
+            pass
+        for v in (10, 20, 30):
+            client.write("ev", v)
+        got = [ev.read() for _ in range(4)]
+        assert [g.value for g in got[:3]] == [10, 20, 30]
+        assert all(g.status == Status.FRESH for g in got[:3])
+        assert got[3].status == Status.EMPTY and got[3].value is None
+
+
+def test_wait_wakes_on_write(client: Client, node: str) -> None:
+    def writer() -> None:
+        time.sleep(0.2)
+        with Client(node) as w:
+            w.write("d", 42.0)
+
+    t = threading.Thread(target=writer)
+    t0 = time.monotonic()
+    t.start()
+    woke = client.wait(timeout=5.0)
+    dt = time.monotonic() - t0
+    t.join()
+    assert woke and 0.1 < dt < 2.0
+    assert client.read("d").value == 42.0
+
+
+def test_wait_times_out(client: Client) -> None:
+    t0 = time.monotonic()
+    assert client.wait(timeout=0.15) is False
+    assert 0.1 < time.monotonic() - t0 < 1.0
+
+
+def test_closed_client(node: str) -> None:
+    c = Client(node)
+    s = c.signal("d")
+    c.close()
+    assert c.closed
+    with pytest.raises(ValueError):
+        s.read()
+    c.close()  # twice is fine
+
+
+def test_library_lookup(tmp_path: Path) -> None:
+    from ccomm import _native
+
+    with pytest.raises(ccomm.LibraryNotFoundError):
+        _native.find_library({"CCOMM_LIBRARY": str(tmp_path / "missing.so")}, [])
+    # A build directory inside a source tree is found from a path inside the tree.
+    (tmp_path / "src" / "include" / "ccomm").mkdir(parents=True)
+    (tmp_path / "src" / "include" / "ccomm" / "ccomm.h").write_text("")
+    (tmp_path / "build-x" / "lib").mkdir(parents=True)
+    lib = tmp_path / "build-x" / "lib" / "libccomm.so.0"
+    lib.write_text("")
+    deep = tmp_path / "python" / "src"
+    deep.mkdir(parents=True)
+    assert _native.find_library({}, [deep]) == str(lib)
+    assert _native.find_library({"CCOMM_BUILD_DIR": str(tmp_path / "build-x")}, []) == str(lib)

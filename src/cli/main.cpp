@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccomm: command-line access to a node's signals (list, echo, pub, stats, gen).
+#include <ctype.h>
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
@@ -28,9 +29,10 @@ const char kUsage[] =
     "\n"
     "Commands:\n"
     "  list                     every signal: type, kind, producer, status, age, value\n"
-    "  echo SIGNAL [-n N] [--timeout SEC] [--once]\n"
+    "  echo SIGNAL [-n N] [--timeout SEC] [--once] [--interval MS]\n"
     "                           print new values/events as they arrive (N of them; default\n"
-    "                           until Ctrl-C); --once prints the current value and status\n"
+    "                           until Ctrl-C); --once prints the current value and status;\n"
+    "                           --interval prints value and status every MS, changed or not\n"
     "  pub SIGNAL VALUE... [--rate HZ] [--count N]\n"
     "                           write a value (arrays: one value per element, or one for all);\n"
     "                           with --rate, repeat N times (default 1) at HZ\n"
@@ -113,16 +115,19 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
   long count = -1;
   double timeout = -1;
   bool once = false;
+  long interval_ms = 0;
   static const struct option kLong[] = {{"count", required_argument, nullptr, 'n'},
+                                        {"interval", required_argument, nullptr, 'i'},
                                         {"timeout", required_argument, nullptr, 't'},
                                         {"once", no_argument, nullptr, 'o'},
                                         {nullptr, 0, nullptr, 0}};
-  optind = 1;
+  optind = 0;  // 0: GNU getopt fully re-initialises (1 keeps stale permutation state)
   int ch;
   while ((ch = getopt_long(argc, argv, "n:t:", kLong, nullptr)) != -1) {
     if (ch == 'n') count = strtol(optarg, nullptr, 10);
     else if (ch == 't') timeout = strtod(optarg, nullptr);
     else if (ch == 'o') once = true;
+    else if (ch == 'i') interval_ms = strtol(optarg, nullptr, 10);
     else return 2;
   }
   if (optind != argc - 1) {
@@ -143,7 +148,7 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
       fprintf(stderr, "ccomm echo: %s\n", ccomm_strerror(r));
       return 1;
     }
-    bool show = once || (d.is_event ? r == CCOMM_FRESH : (r != CCOMM_NEVER && (first || info.seq != last_seq)));
+    bool show = once || interval_ms > 0 || (d.is_event ? r == CCOMM_FRESH : (r != CCOMM_NEVER && (first || info.seq != last_seq)));
     if (show) {
       printf("%s %s %s%s seq=%" PRIu64 " age_us=%" PRId64 " lost=%" PRIu64 "\n", d.name,
              (r == CCOMM_NEVER || r == CCOMM_EMPTY) && !(info.flags & CCOMM_INFO_SAFE_VALUE)
@@ -155,10 +160,15 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
       first = false;
       printed++;
       if (once) return 0;
-      if (d.is_event) continue;  // drain queued events before waiting
+      if (d.is_event && interval_ms <= 0) continue;  // drain queued events before waiting
     }
     if (timeout >= 0 && (ccomm::platform::MonotonicNs() - start) / 1e9 > timeout) break;
-    ccomm_wait(c, 100);
+    if (interval_ms > 0) {
+      struct timespec ts = {interval_ms / 1000, (interval_ms % 1000) * 1000000};
+      nanosleep(&ts, nullptr);
+    } else {
+      ccomm_wait(c, 100);
+    }
   }
   return (count >= 0 && printed < count) ? 3 : 0;
 }
@@ -166,27 +176,41 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
 int CmdPub(ccomm_client* c, int argc, char** argv) {
   double rate = 0;
   long count = 1;
-  static const struct option kLong[] = {{"rate", required_argument, nullptr, 'r'},
-                                        {"count", required_argument, nullptr, 'n'},
-                                        {nullptr, 0, nullptr, 0}};
-  optind = 1;
-  int ch;
-  // "+" stops at the first non-option so negative values ("-1.5") are not options.
-  while ((ch = getopt_long(argc, argv, "+r:n:", kLong, nullptr)) != -1) {
-    if (ch == 'r') rate = strtod(optarg, nullptr);
-    else if (ch == 'n') count = strtol(optarg, nullptr, 10);
-    else return 2;
+  // Options may come anywhere; words that are numbers ("-1.5") are values, not options.
+  std::vector<char*> pos;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    bool opt_rate = a == "--rate" || a == "-r", opt_count = a == "--count" || a == "-n";
+    if ((opt_rate || opt_count) && i + 1 < argc) {
+      char* end = nullptr;
+      double v = strtod(argv[++i], &end);
+      if (*end || v <= 0) {
+        fprintf(stderr, "ccomm pub: %s needs a positive number, not '%s'\n", a.c_str(), argv[i]);
+        return 2;
+      }
+      if (opt_rate) rate = v;
+      else count = static_cast<long>(v);
+    } else if (a.rfind("--rate=", 0) == 0) {
+      rate = strtod(a.c_str() + 7, nullptr);
+    } else if (a.rfind("--count=", 0) == 0) {
+      count = strtol(a.c_str() + 8, nullptr, 10);
+    } else if (a.size() > 1 && a[0] == '-' && !(isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')) {
+      fprintf(stderr, "ccomm pub: unknown option '%s'\n", a.c_str());
+      return 2;
+    } else {
+      pos.push_back(argv[i]);
+    }
   }
-  if (argc - optind < 2) {
+  if (pos.size() < 2) {
     fprintf(stderr, "ccomm pub: give SIGNAL and VALUE...\n");
     return 2;
   }
   ccomm_signal_desc d;
-  ccomm_signal s = Find(c, argv[optind], &d);
+  ccomm_signal s = Find(c, pos[0], &d);
   if (s < 0) return 1;
   std::vector<uint8_t> buf(d.value_bytes);
   std::string err;
-  if (!ccomm::cli::ParseValue(d, argc - optind - 1, argv + optind + 1, buf.data(), &err)) {
+  if (!ccomm::cli::ParseValue(d, static_cast<int>(pos.size() - 1), pos.data() + 1, buf.data(), &err)) {
     fprintf(stderr, "ccomm pub: %s: %s\n", d.name, err.c_str());
     return 1;
   }

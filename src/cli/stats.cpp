@@ -137,7 +137,7 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   static const struct option kLong[] = {{"json", no_argument, nullptr, 'j'},
                                         {"watch", required_argument, nullptr, 'w'},
                                         {nullptr, 0, nullptr, 0}};
-  optind = 1;
+  optind = 0;  // 0: GNU getopt fully re-initialises (1 keeps stale permutation state)
   int ch;
   while ((ch = getopt_long(argc, argv, "jw:", kLong, nullptr)) != -1) {
     if (ch == 'j') json = true;

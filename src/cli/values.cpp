@@ -40,8 +40,24 @@ static std::string FormatOne(int type, const uint8_t* p) {
     case CCOMM_INT32: { int32_t v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%" PRId32, v); break; }
     case CCOMM_UINT32: { uint32_t v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%" PRIu32, v); break; }
     case CCOMM_INT64: { int64_t v; memcpy(&v, p, 8); snprintf(buf, sizeof buf, "%" PRId64, v); break; }
-    case CCOMM_FLOAT: { float v; memcpy(&v, p, 4); snprintf(buf, sizeof buf, "%.9g", static_cast<double>(v)); break; }
-    case CCOMM_DOUBLE: { double v; memcpy(&v, p, 8); snprintf(buf, sizeof buf, "%.17g", v); break; }
+    case CCOMM_FLOAT: {
+      float v;
+      memcpy(&v, p, 4);
+      for (int prec = 6; prec <= 9; ++prec) {  // shortest text that reads back exactly
+        snprintf(buf, sizeof buf, "%.*g", prec, static_cast<double>(v));
+        if (strtof(buf, nullptr) == v) break;
+      }
+      break;
+    }
+    case CCOMM_DOUBLE: {
+      double v;
+      memcpy(&v, p, 8);
+      for (int prec = 15; prec <= 17; ++prec) {
+        snprintf(buf, sizeof buf, "%.*g", prec, v);
+        if (strtod(buf, nullptr) == v) break;
+      }
+      break;
+    }
     default: return "?";
   }
   return buf;

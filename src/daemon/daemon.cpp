@@ -80,9 +80,16 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     }
   }
 
-  r = kind == TransportKind::kRaw ? OpenRawTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error)
-                                  : OpenUdpTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error);
-  if (r != 0) return r;
+  bool any_peer = false;
+  for (const PeerTx& pt : peers_tx_) any_peer = any_peer || pt.active;
+  if (!any_peer) {
+    // Local-only node: apps talk through shared memory; no socket, no privileges needed.
+    transport_ = Transport();
+  } else {
+    r = kind == TransportKind::kRaw ? OpenRawTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error)
+                                    : OpenUdpTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error);
+    if (r != 0) return r;
+  }
 
   uint64_t now = platform::MonotonicNs();
   for (uint32_t id : periodic_) due_ns_[id] = now;

@@ -111,6 +111,11 @@ void Daemon::RunRx() {
   platform::PrefaultStack(32 * 1024);
   while (running_.load(std::memory_order_relaxed)) {
     rx_loops_.fetch_add(1, std::memory_order_relaxed);
+    if (!transport_.ops) {  // local-only node: nothing to receive
+      struct timespec ts = {0, opt_.recv_timeout_ms * 1000 * 1000};
+      nanosleep(&ts, nullptr);
+      continue;
+    }
     PeerAddress from;
     ssize_t n = transport_.Recv(rx_buf_, sizeof rx_buf_, &from);
     if (n > 0) {

@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: Apache-2.0
+// Frame authentication with libsodium's keyed BLAKE2b (crypto_generichash, 16-byte
+// output) and the per-sender replay window. See auth.h and docs/protocol.md.
+#include "daemon/auth.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#ifdef CCOMM_HAVE_SODIUM
+#include <sodium.h>
+#endif
+
+namespace ccomm {
+namespace auth {
+namespace {
+
+int HexDigit(uint8_t c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+void Wipe(void* p, size_t n) {
+#ifdef CCOMM_HAVE_SODIUM
+  sodium_memzero(p, n);
+#else
+  volatile uint8_t* v = static_cast<volatile uint8_t*>(p);
+  while (n--) *v++ = 0;
+#endif
+}
+
+}  // namespace
+
+bool Available() {
+#ifdef CCOMM_HAVE_SODIUM
+  return true;
+#else
+  return false;
+#endif
+}
+
+int LoadKeyFile(const std::string& path, uint8_t key[kKeyBytes], std::string* error) {
+  int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    int e = errno;
+    *error = "cannot open auth key file " + path + ": " + strerror(e);
+    if (e == EACCES) *error += " (it must be readable by the user ccommd runs as)";
+    return -e;
+  }
+  // Check the file we opened, not the name (no race with a swapped path).
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    close(fd);
+    *error = "auth key file " + path + " is not a regular file";
+    return -EINVAL;
+  }
+  if (st.st_mode & (S_IRWXG | S_IRWXO)) {
+    close(fd);
+    char mode[8];
+    snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    *error = "auth key file " + path + " has mode " + mode +
+             ": a pre-shared key must not be accessible by group or others; refusing to start "
+             "(fix: chmod 600 " + path + ")";
+    return -EPERM;
+  }
+  if (st.st_uid != 0 && st.st_uid != geteuid()) {
+    close(fd);
+    *error = "auth key file " + path + " is owned by uid " + std::to_string(st.st_uid) +
+             ", not by root or the user ccommd runs as; refusing to start";
+    return -EPERM;
+  }
+  uint8_t buf[2 * kKeyBytes + 2];
+  ssize_t n = read(fd, buf, sizeof buf);
+  close(fd);
+  int r = 0;
+  if (n == static_cast<ssize_t>(kKeyBytes)) {
+    memcpy(key, buf, kKeyBytes);
+  } else if (n >= static_cast<ssize_t>(2 * kKeyBytes) && n <= static_cast<ssize_t>(2 * kKeyBytes + 1) &&
+             (n == static_cast<ssize_t>(2 * kKeyBytes) || buf[2 * kKeyBytes] == '\n')) {
+    for (size_t i = 0; i < kKeyBytes && r == 0; ++i) {
+      int hi = HexDigit(buf[2 * i]), lo = HexDigit(buf[2 * i + 1]);
+      if (hi < 0 || lo < 0) r = -EINVAL;
+      else key[i] = static_cast<uint8_t>(hi << 4 | lo);
+    }
+  } else {
+    r = -EINVAL;
+  }
+  Wipe(buf, sizeof buf);
+  if (r != 0 || n < 0) {
+    Wipe(key, kKeyBytes);
+    *error = "auth key file " + path +
+             " must hold exactly 32 random bytes or 64 hex digits (e.g. made with: "
+             "head -c 32 /dev/urandom > FILE)";
+    return -EINVAL;
+  }
+  return 0;
+}
+
+FrameAuth::~FrameAuth() { Wipe(key_, sizeof key_); }
+
+int FrameAuth::Load(const std::string& path, std::string* error) {
+  if (!Available()) {
+    *error = "auth_key_file is set but this ccommd was built without libsodium "
+             "(CCOMM_WITH_SODIUM): refusing to run unauthenticated";
+    return -ENOTSUP;
+  }
+#ifdef CCOMM_HAVE_SODIUM
+  if (sodium_init() < 0) {
+    *error = "libsodium failed to initialise";
+    return -EIO;
+  }
+#endif
+  uint8_t key[kKeyBytes];
+  int r = LoadKeyFile(path, key, error);
+  if (r != 0) return r;
+  SetKey(key);
+  Wipe(key, sizeof key);
+  return 0;
+}
+
+void FrameAuth::SetKey(const uint8_t key[kKeyBytes]) {
+  memcpy(key_, key, kKeyBytes);
+  enabled_ = Available();
+}
+
+void FrameAuth::Sign(const uint8_t* frame, size_t len, uint8_t* tag) const {
+#ifdef CCOMM_HAVE_SODIUM
+  crypto_generichash(tag, kTagBytes, frame, len, key_, kKeyBytes);
+#else
+  (void)frame;
+  (void)len;
+  memset(tag, 0, kTagBytes);  // unreachable: enabled_ is never true without libsodium
+#endif
+}
+
+bool FrameAuth::Accept(const uint8_t* frame, size_t len, uint8_t flags) const {
+  const bool tagged = (flags & wire::kFlagAuth) != 0;
+  if (!enabled_) return !tagged;
+  if (!tagged || len < wire::kHeaderSize + kTagBytes) return false;
+#ifdef CCOMM_HAVE_SODIUM
+  uint8_t expect[kTagBytes];
+  Sign(frame, len - kTagBytes, expect);
+  return sodium_memcmp(expect, frame + len - kTagBytes, kTagBytes) == 0;
+#else
+  (void)frame;
+  return false;
+#endif
+}
+
+void ReplayWindow::Reset(uint32_t seq, uint64_t send_ns, uint64_t now_ns) {
+  seen_ = true;
+  top_ = seq;
+  bits_ = 1;
+  top_send_ns_ = send_ns;
+  floor_ns_ = send_ns;
+  last_rx_ns_ = now_ns;
+}
+
+ReplayVerdict ReplayWindow::Check(uint32_t seq, uint64_t send_ns, uint64_t now_ns,
+                                  uint64_t peer_timeout_ns) {
+  if (!seen_) {
+    Reset(seq, send_ns, now_ns);
+    return ReplayVerdict::kAccept;
+  }
+  const int32_t d = static_cast<int32_t>(seq - top_);  // serial-number arithmetic
+  if (d > 0 && send_ns >= top_send_ns_) {
+    bits_ = static_cast<uint32_t>(d) >= kWidth ? 0 : bits_ << d;
+    bits_ |= 1;
+    top_ = seq;
+    top_send_ns_ = send_ns;
+    last_rx_ns_ = now_ns;
+    return ReplayVerdict::kAccept;
+  }
+  if (d <= 0 && static_cast<uint32_t>(-static_cast<int64_t>(d)) < kWidth && send_ns <= top_send_ns_ &&
+      send_ns >= floor_ns_) {
+    const uint64_t bit = uint64_t{1} << static_cast<uint32_t>(-static_cast<int64_t>(d));
+    if (bits_ & bit) return ReplayVerdict::kReplay;  // seen: duplicate or replay
+    bits_ |= bit;                                     // late but new: reordered
+    last_rx_ns_ = now_ns;
+    return ReplayVerdict::kAccept;
+  }
+  // Outside the window, or inconsistent with it.
+  if (send_ns > top_send_ns_) {
+    // The sender's counter went back while its clock went on: its ccommd restarted.
+    Reset(seq, send_ns, now_ns);
+    return ReplayVerdict::kRestart;
+  }
+  const uint64_t silence = now_ns - last_rx_ns_;
+  if (silence > peer_timeout_ns && send_ns <= silence) {
+    // Both went back: the board rebooted, which fits only if its uptime is shorter than
+    // the time we have not heard from it.
+    Reset(seq, send_ns, now_ns);
+    return ReplayVerdict::kRestart;
+  }
+  return ReplayVerdict::kReplay;
+}
+
+}  // namespace auth
+}  // namespace ccomm

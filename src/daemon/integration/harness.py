@@ -1,0 +1,146 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Two-node harness for ccommd integration tests: network namespaces joined by a veth
+pair (eth0 inside each, as on the boards), one ccommd per namespace, CLI helpers.
+
+Everything created here is removed again, also when a test fails."""
+import json
+import os
+import signal
+import subprocess
+import time
+import uuid
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+BUILD = os.environ.get("CCOMM_BUILD_DIR", os.path.join(ROOT, "build"))
+BIN = os.path.join(BUILD, "bin")
+DEFAULT_CONFIG = os.path.join(ROOT, "dist", "signals.xml")
+
+
+def run(cmd, check=True, **kw):
+    return subprocess.run(cmd, check=check, capture_output=True, text=True, **kw)
+
+
+class NodePair:
+    """control (10.42.0.1) and planner (10.42.0.2) in namespaces <tag>-c / <tag>-p."""
+
+    def __init__(self, config=DEFAULT_CONFIG, transport=None, env=None, preload=None):
+        tag = "cci" + uuid.uuid4().hex[:6]
+        self.ns = {"control": tag + "-c", "planner": tag + "-p"}
+        self.config = config
+        self.transport = transport
+        self.env = dict(os.environ)
+        self.env["CCOMM_SHM_PREFIX"] = "/" + tag + "."
+        self.env.update(env or {})
+        self.preload = preload
+        self.daemons = {}
+        self.logs = {}
+        self.bg = []
+
+    def __enter__(self):
+        c, p = self.ns["control"], self.ns["planner"]
+        run(["ip", "netns", "add", c])
+        run(["ip", "netns", "add", p])
+        run(["ip", "link", "add", "eth0", "netns", c, "type", "veth", "peer", "name", "eth0", "netns", p])
+        for ns, ip in ((c, "10.42.0.1/24"), (p, "10.42.0.2/24")):
+            run(["ip", "-n", ns, "addr", "add", ip, "dev", "eth0"])
+            run(["ip", "-n", ns, "link", "set", "eth0", "up"])
+            run(["ip", "-n", ns, "link", "set", "lo", "up"])
+        return self
+
+    def __exit__(self, *exc):
+        for proc in self.bg:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        for node in list(self.daemons):
+            self.stop(node)
+        for ns in self.ns.values():
+            run(["ip", "netns", "del", ns], check=False)
+        for node in self.ns:
+            path = "/dev/shm/" + self.env["CCOMM_SHM_PREFIX"].lstrip("/") + node
+            if os.path.exists(path):
+                os.unlink(path)
+
+    def exec_prefix(self, node):
+        return ["ip", "netns", "exec", self.ns[node]]
+
+    def start(self, node, extra=(), wait=True):
+        cmd = self.exec_prefix(node) + [os.path.join(BIN, "ccommd"), "--node", node, "--no-rt",
+                                        "-c", self.config] + list(extra)
+        if self.transport:
+            cmd += ["--transport", self.transport]
+        env = dict(self.env)
+        if self.preload:
+            env["LD_PRELOAD"] = self.preload
+            env["CCOMM_ALLOC_REPORT"] = "/tmp/%s-%s.alloc" % (self.ns[node], node)
+        log = open("/tmp/%s.log" % self.ns[node], "w")
+        self.logs[node] = log.name
+        self.daemons[node] = subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
+        if wait:
+            self.wait_ready(node)
+
+    def wait_ready(self, node, timeout=5.0):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            r = self.cli(node, "stats", "--json", check=False)
+            if r.returncode == 0 and json.loads(r.stdout)["daemon_alive"]:
+                return
+            if self.daemons[node].poll() is not None:
+                raise AssertionError("ccommd %s exited: %s" % (node, self.log(node)))
+            time.sleep(0.05)
+        raise AssertionError("ccommd %s not ready: %s" % (node, self.log(node)))
+
+    def stop(self, node, sig=signal.SIGTERM):
+        proc = self.daemons.pop(node, None)
+        if proc and proc.poll() is None:
+            proc.send_signal(sig)
+            try:
+                proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+                raise AssertionError("ccommd %s did not stop on %s" % (node, sig))
+        return proc.returncode if proc else None
+
+    def log(self, node):
+        with open(self.logs[node]) as f:
+            return f.read()
+
+    def cli(self, node, *args, check=True, timeout=20):
+        return run(self.exec_prefix(node) + [os.path.join(BIN, "ccomm"), "--node", node] + list(args),
+                   check=check, env=self.env, timeout=timeout)
+
+    def spawn(self, node, *args, tool="ccomm"):
+        proc = subprocess.Popen(self.exec_prefix(node) + [os.path.join(BIN, tool), "--node", node] + list(args),
+                                env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.bg.append(proc)
+        return proc
+
+    def stats(self, node):
+        return json.loads(self.cli(node, "stats", "--json").stdout)
+
+    def echo_once(self, node, signal_name):
+        """(value, status) of a signal as an app on `node` reads it now."""
+        out = self.cli(node, "echo", signal_name, "--once").stdout.split()
+        return out[1], out[2].rstrip("*")
+
+    def link(self, node, up):
+        run(["ip", "-n", self.ns[node], "link", "set", "eth0", "up" if up else "down"])
+
+
+def signal_stats(stats, name):
+    return next(s for s in stats["signals"] if s["name"] == name)
+
+
+def peer_stats(stats, name):
+    return next(p for p in stats["peers"] if p["name"] == name)
+
+
+def wait_for(predicate, timeout, interval=0.01):
+    """Polls until predicate() is truthy; returns seconds taken, or None on timeout."""
+    start = time.time()
+    while time.time() - start < timeout:
+        if predicate():
+            return time.time() - start
+        time.sleep(interval)
+    return None

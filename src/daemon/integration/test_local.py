@@ -1,0 +1,38 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Two apps on one node talk through shared memory only (no network, no root needed
+by ccommd for a local-only node)."""
+import os
+
+from harness import ROOT, NodePair
+
+LOCAL = """<?xml version="1.0"?>
+<ccomm version="1">
+  <node name="control" interface="eth0"/>
+  <signal name="camera_x" type="double" producer="control" stale_after_ms="100"/>
+  <signal name="targets" type="float" count="4" producer="control"/>
+  <signal name="estop" type="bool" kind="event" producer="control"/>
+</ccomm>
+"""
+
+
+def test_two_apps_one_node(tmp_path):
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        assert "transport none" in pair.log("control")
+        reader = pair.spawn("control", "echo", "estop", "-n", "2", "--timeout", "5")
+        pair.cli("control", "pub", "camera_x", "3.5")
+        pair.cli("control", "pub", "targets", "1,2,3,4")
+        assert pair.echo_once("control", "camera_x") == ("3.5", "fresh")
+        out = pair.cli("control", "echo", "targets", "--once").stdout
+        assert "[1, 2, 3, 4] fresh" in out
+        import time
+        time.sleep(0.3)  # the event reader subscribes when it attaches
+        pair.cli("control", "pub", "estop", "1")
+        pair.cli("control", "pub", "estop", "0")
+        lines = reader.communicate(timeout=10)[0].splitlines()
+        assert [l.split()[1] for l in lines] == ["true", "false"], lines
+        st = pair.stats("control")
+        assert st["counters"]["frames_tx"] == 0 and st["counters"]["frames_rx"] == 0
+    assert os.path.isdir(ROOT)

@@ -1,0 +1,62 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Two ccommd in two network namespaces: signals flow both ways, over raw Ethernet and UDP."""
+import json
+import os
+
+import pytest
+
+from harness import BIN, NodePair, peer_stats, signal_stats
+
+
+@pytest.mark.parametrize("transport", [None, "udp"], ids=["raw", "udp"])
+def test_setup_simulation_both_ways(transport):
+    with NodePair(transport=transport) as pair:
+        pair.start("control")
+        pair.start("planner")
+        # Exact values, both directions, through the CLI. Published at 200 Hz: these
+        # signals go stale 20 ms after the last value (and then read as the safe value).
+        pubs = [pair.spawn("control", "pub", "arm3_torque", "-12.5", "--rate", "200", "--count", "200"),
+                pair.spawn("planner", "pub", "base_theta_sp", "0.785", "--rate", "200", "--count", "200")]
+        assert pair.cli("planner", "echo", "arm3_torque", "-n", "1", "--timeout", "3").stdout.split()[1] == "-12.5"
+        assert pair.cli("control", "echo", "base_theta_sp", "-n", "1", "--timeout", "3").stdout.split()[1] == "0.785"
+        for p in pubs:
+            assert p.wait(timeout=10) == 0
+        frames_before = peer_stats(pair.stats("control"), "planner")["frames_tx"]
+        # The thesis setup-simulation at 1 kHz: 36 doubles one way, 9 back, in parallel.
+        lat = os.path.join(BIN, "ccomm-latency")
+        a = pair.spawn("control", "--rate", "1000", "--duration", "2", tool="ccomm-latency")
+        b = pair.spawn("planner", "--rate", "1000", "--duration", "2", tool="ccomm-latency")
+        ra = json.loads(a.communicate(timeout=30)[0])
+        rb = json.loads(b.communicate(timeout=30)[0])
+        assert lat
+        for r, sent_by_peer in ((ra, rb["sent"]), (rb, ra["sent"])):
+            assert r["count"] > 1000, r
+            # Loss must be small even on a loaded 2-core CI machine.
+            assert r["lost"] <= 0.02 * sent_by_peer, r
+        assert ra["send_signals"] == 36 and rb["send_signals"] == 9
+        st = pair.stats("planner")
+        assert signal_stats(st, "wheel0_pos")["rx"] >= 1500
+        assert peer_stats(st, "control")["alive"]
+        assert st["counters"]["frames_bad"] == 0
+        # One frame per cycle: control sent 36 doubles per cycle in (about) one frame each.
+        ctrl = pair.stats("control")
+        frames = peer_stats(ctrl, "planner")["frames_tx"] - frames_before
+        assert frames <= ra["sent"] + 20, (frames, ra["sent"])  # + a few heartbeats
+
+
+def test_wrong_config_hash_is_rejected_and_counted(tmp_path):
+    """A board running a different signals.xml must not be believed."""
+    from harness import DEFAULT_CONFIG
+    other = tmp_path / "other.xml"
+    other.write_text(open(DEFAULT_CONFIG).read().replace('name="arm5_torque" type="double"',
+                                                          'name="arm5_torque" type="float"'))
+    with NodePair() as pair:
+        pair.start("control")
+        pair.config = str(other)
+        pair.start("planner")
+        pair.cli("control", "pub", "wheel0_pos", "1")
+        import time
+        time.sleep(0.5)
+        st = pair.stats("planner")
+        assert st["counters"]["frames_wrong_hash"] > 0
+        assert signal_stats(st, "wheel0_pos")["rx"] == 0

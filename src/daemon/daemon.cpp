@@ -67,6 +67,12 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
   }
 
+  replay_.assign(m, auth::ReplayWindow());
+  if (!cfg.network.auth_key_file.empty()) {
+    int ar = auth_.Load(cfg.network.auth_key_file, error);
+    if (ar != 0) return ar;
+  }
+
   // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
   int gid = -1;
   if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "config/config.h"
+#include "daemon/auth.h"
 #include "daemon/transport.h"
 #include "store/segment.h"
 #include "wire/wire.h"
@@ -83,6 +84,8 @@ class Daemon {
   store::Segment segment_;
   bool adopted_ = false;
   Transport transport_;
+  auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
+  std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};
 

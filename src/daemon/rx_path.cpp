@@ -15,6 +15,11 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
     Count(store::kFramesBad);
     return;
   }
+  // Authenticate before any field is trusted (the decode above only checked bounds).
+  if (!auth_.Accept(buf, len, h.flags)) {
+    Count(store::kFramesAuthFailed);
+    return;
+  }
   if (h.config_hash != cfg_->hash) {
     Count(store::kFramesWrongHash);
     return;
@@ -25,6 +30,11 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   }
   if (h.dest != self_ && h.dest != wire::kDestAll) {
     Count(store::kFramesNotForUs);  // a broadcast frame meant for another node
+    return;
+  }
+  if (auth_.enabled() &&
+      replay_[h.sender].Check(h.seq, h.send_time_ns, now, peer_timeout_ns_) == auth::ReplayVerdict::kReplay) {
+    Count(store::kFramesReplayed);  // an authentic frame seen before (or older than the window)
     return;
   }
   Count(store::kFramesRx);

@@ -12,7 +12,7 @@ namespace ccomm {
 void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
   PeerTx& p = peers_tx_[peer];
   wire::FrameHeader h;
-  h.flags = flags;
+  h.flags = flags | auth_.frame_flags();  // kFlagAuth: the writer keeps room for the tag
   h.sender = static_cast<uint16_t>(self_);
   h.dest = static_cast<uint16_t>(peer);
   h.config_hash = cfg_->hash;
@@ -28,6 +28,10 @@ void Daemon::FlushPeer(uint32_t peer) {
   size_t len = p.writer.Finish();
   p.open = false;
   if (len == 0) return;  // nothing in it (a data frame is never empty)
+  if (auth_.enabled()) {
+    auth_.Sign(p.buf, len, p.buf + len);
+    len += wire::kAuthTagSize;
+  }
   p.seq++;
   int r = transport_.Send(p.addr, p.buf, len);
   p.last_tx_ns = platform::MonotonicNs();  // also on failure: a dead link must not busy-loop

@@ -3,7 +3,7 @@
 // ccommd calls ccomm_steady_state_begin() once start-up is done and
 // ccomm_steady_state_end() when asked to stop; every malloc/calloc/realloc/
 // posix_memalign/aligned_alloc in between, from any thread, is counted. At exit the
-// count goes to $CCOMM_ALLOC_REPORT ("steady_state_allocations N").
+// count goes to $CCOMM_ALLOC_REPORT ("steady_state_allocations N", then "total_allocations M" incl. start-up).
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,8 +20,9 @@ void __libc_free(void*);
 
 namespace {
 std::atomic<bool> g_counting{false};
-std::atomic<unsigned long> g_count{0};
+std::atomic<unsigned long> g_count{0}, g_total{0};
 inline void Count() {
+  g_total.fetch_add(1, std::memory_order_relaxed);  // proves the interposer is live
   if (g_counting.load(std::memory_order_relaxed)) g_count.fetch_add(1, std::memory_order_relaxed);
 }
 }  // namespace
@@ -58,7 +59,7 @@ void ccomm_steady_state_end() {
   if (!path) return;
   FILE* f = fopen(path, "w");
   if (!f) return;
-  fprintf(f, "steady_state_allocations %lu\n", g_count.load());
+  fprintf(f, "steady_state_allocations %lu\ntotal_allocations %lu\n", g_count.load(), g_total.load());
   fclose(f);
 }
 

@@ -97,6 +97,8 @@ class NodePair:
             try:
                 proc.wait(timeout=5)
             except subprocess.TimeoutExpired:
+                bt = run(["gdb", "-p", str(proc.pid), "-batch", "-ex", "thread apply all bt"], check=False).stdout
+                print("ccommd %s stuck; log:\n%s\nbacktrace:\n%s" % (node, self.log(node), bt))
                 proc.kill()
                 proc.wait()
                 raise AssertionError("ccommd %s did not stop on %s" % (node, sig))

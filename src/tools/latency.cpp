@@ -39,6 +39,9 @@ const char kUsage[] =
     "      --recv A,B,...     signals to wait for (default: doubles consumed here)\n"
     "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
     "      --prio N           SCHED_FIFO priority for the send loop (needs CAP_SYS_NICE)\n"
+    "      --spin             receive by busy-polling the signals instead of ccomm_wait()\n"
+    "                         (an RT loop's view: no wake-up; costs one core)\n"
+    "      --cpu N            pin the receive thread to CPU N\n"
     "      --label TEXT       name in the JSON result\n"
     "      --samples FILE     write every latency sample (ns) to FILE\n"
     "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
@@ -50,6 +53,8 @@ struct Options {
   std::string mode = "oneway", label = "ccomm", samples_file;
   std::string send, recv;
   int prio = 0;
+  bool spin = false;
+  int cpu = -1;
 };
 
 uint64_t Now() {
@@ -80,7 +85,8 @@ struct Shared {
   std::vector<uint64_t> send_time;  // [k % kHistory]
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> sent{0};
-  bool ping = false, echo = false;
+  bool ping = false, echo = false, spin = false;
+  int cpu = -1;
   uint64_t warmup_until = 0;
   std::vector<int64_t> samples;
   uint64_t first_k = 0, last_k = 0, received = 0;
@@ -99,8 +105,14 @@ void* Receiver(void* arg) {
   std::vector<double> got(n, -1);
   std::vector<uint64_t> src(n, 0);
   double last_complete = -1;
+  if (s->cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(s->cpu, &set);
+    pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+  }
   while (!s->stop.load(std::memory_order_relaxed)) {
-    ccomm_wait(s->rx_client, 50);
+    if (!s->spin) ccomm_wait(s->rx_client, 50);
     uint64_t now = Now();
     bool changed = false;
     for (size_t i = 0; i < n; ++i) {
@@ -181,6 +193,7 @@ int main(int argc, char** argv) {
       {"send", required_argument, nullptr, 'S'},   {"recv", required_argument, nullptr, 'R'},
       {"warmup", required_argument, nullptr, 'W'}, {"prio", required_argument, nullptr, 'P'},
       {"label", required_argument, nullptr, 'L'},  {"samples", required_argument, nullptr, 'F'},
+      {"spin", no_argument, nullptr, 'X'},         {"cpu", required_argument, nullptr, 'C'},
       {"help", no_argument, nullptr, 'h'},         {nullptr, 0, nullptr, 0}};
   int ch;
   while ((ch = getopt_long(argc, argv, "n:r:d:m:h", kLong, nullptr)) != -1) {
@@ -195,6 +208,8 @@ int main(int argc, char** argv) {
       case 'P': o.prio = atoi(optarg); break;
       case 'L': o.label = optarg; break;
       case 'F': o.samples_file = optarg; break;
+      case 'X': o.spin = true; break;
+      case 'C': o.cpu = atoi(optarg); break;
       case 'h': fputs(kUsage, stdout); return 0;
       default: fputs(kUsage, stderr); return 2;
     }
@@ -214,6 +229,8 @@ int main(int argc, char** argv) {
   s.recv = Resolve(s.rx_client, o.recv, false, "--recv");
   s.ping = o.mode == "ping";
   s.echo = o.mode == "echo";
+  s.spin = o.spin;
+  s.cpu = o.cpu;
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort

@@ -6,6 +6,7 @@
 #include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -41,6 +42,27 @@ bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_n
   }
   long r = syscall(SYS_futex, reinterpret_cast<uint32_t*>(word), FUTEX_WAIT, expected, tsp, nullptr, 0);
   return !(r != 0 && errno == ETIMEDOUT);
+}
+
+namespace {
+std::atomic<uint32_t> g_pid{0};
+void ResetPid() { g_pid.store(static_cast<uint32_t>(getpid()), std::memory_order_relaxed); }
+}  // namespace
+
+uint32_t ProcessId() {
+  uint32_t p = g_pid.load(std::memory_order_relaxed);
+  if (__builtin_expect(p == 0, 0)) {
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, [] { pthread_atfork(nullptr, nullptr, ResetPid); });
+    ResetPid();
+    p = g_pid.load(std::memory_order_relaxed);
+  }
+  return p;
+}
+
+bool ProcessAlive(uint32_t pid) {
+  if (pid == 0) return false;
+  return !(kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH);
 }
 
 int ShmOpen(const char* name, bool create_exclusive, int mode) {

@@ -28,6 +28,11 @@ void FutexWake(std::atomic<uint32_t>* word, int n);
 /// Blocks while *word == expected, at most timeout_ns (<0 = forever). Returns false on timeout.
 bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_ns);
 
+/// [rt] This process's pid, cached (refreshed after fork); no syscall.
+uint32_t ProcessId();
+/// False only if no process `pid` exists (kill(pid, 0) == ESRCH). Not [rt].
+bool ProcessAlive(uint32_t pid);
+
 /// Shared memory. Names are POSIX shm names ("/ccomm.node").
 int ShmOpen(const char* name, bool create_exclusive, int mode);  // fd or -errno
 int ShmUnlink(const char* name);                                   // 0 or -errno

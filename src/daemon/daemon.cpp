@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "common/platform.h"
+#include "store/reclaim.h"
 
 namespace ccomm {
 
@@ -78,6 +79,12 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
   int r = segment_.CreateOrAdopt(cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
+  reclaim_suspects_.assign(store::SlotCount(segment_), 0);
+  if (adopted_) {
+    // Writers that died while this ccommd was down may have left slots half-written.
+    size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);
+    if (freed) Log(LogLevel::kNotice, "reclaimed %zu slots left by dead writers", freed);
+  }
   for (size_t i = 0; i < n; ++i) {
     const auto& d = segment_.dir(static_cast<uint32_t>(i));
     if ((d.flags & store::kSigEvent) && (d.flags & store::kSigForwarded)) {
@@ -109,6 +116,11 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
 void Daemon::Supervise(uint64_t now) {
   store::SegmentHeader* h = segment_.header();
   h->daemon_heartbeat_ns.store(now, std::memory_order_release);
+  if (now >= next_reclaim_ns_) {
+    next_reclaim_ns_ = now + 1000000000ull;
+    size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);
+    if (freed) h->daemon_counters[store::kSlotsReclaimed].fetch_add(freed, std::memory_order_relaxed);
+  }
   for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
     if (!peers_tx_[p].active) continue;
     store::PeerStats& ps = segment_.peer(p);

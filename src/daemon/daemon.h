@@ -99,6 +99,8 @@ class Daemon {
   std::vector<uint64_t> last_rx_seq_;             // signal -> last value_seq received
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
+  std::vector<uint64_t> reclaim_suspects_;        // slot -> odd seq seen at the last scan
+  uint64_t next_reclaim_ns_ = 0;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_value_[kMaxValueBytes];

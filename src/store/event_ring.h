@@ -20,6 +20,7 @@
 #include <atomic>
 #include <cstdint>
 
+#include "common/platform.h"
 #include "store/layout.h"
 #include "store/state_slot.h"
 #include "store/word_copy.h"
@@ -61,6 +62,7 @@ inline StoreResult RingWrite(const RingView& v, const void* value, uint64_t valu
   if ((prev & 1) || prev > 2 * h ||
       !s->seq.compare_exchange_strong(prev, 2 * h + 1, std::memory_order_acq_rel))
     return StoreResult::kBusy;  // ticket h stays a hole; readers skip it after a timeout
+  s->owner.store((uint64_t{platform::ProcessId()} << 32) | (h & 0xffffffffu), std::memory_order_relaxed);
   std::atomic_thread_fence(std::memory_order_release);
   uint64_t vs = value_seq ? value_seq : h + 1;
   s->value_seq.store(vs, std::memory_order_relaxed);

@@ -25,7 +25,7 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 1;
+constexpr uint32_t kLayoutVersion = 2;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
@@ -67,7 +67,7 @@ struct alignas(kCacheLine) SegmentHeader {
 enum DaemonCounter : uint32_t {
   kFramesRx = 0, kFramesTx, kFramesBad, kFramesWrongHash, kFramesUnknownSender,
   kFramesAuthFailed, kFramesReplayed, kFramesNotForUs, kEntriesUnknownSignal,
-  kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kDaemonCounterCount
+  kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kSlotsReclaimed, kDaemonCounterCount
 };
 
 enum SignalFlags : uint32_t {
@@ -98,14 +98,17 @@ struct alignas(8) SignalDirectoryEntry {
 };
 
 // Header of every slot (state copy or event), followed by the value rounded up to 8 bytes.
-// `seq` protocol (ticket t): 2t+1 while being written, 2t+2 when complete, 0 = never.
+// `seq` protocol (ticket t): 2t+1 while being written, 2t+2 when complete, 0 = free.
+// `owner` = (writer pid << 32) | (t & 0xffffffff), stored right after the claim, lets
+// ccommd tell a dead writer's slot from a slow one (store/reclaim.h).
 struct alignas(8) SlotHeader {
   std::atomic<uint64_t> seq;
+  std::atomic<uint64_t> owner;
   std::atomic<uint64_t> value_seq;       // producer's sequence number of the value
   std::atomic<uint64_t> source_time_ns;  // producer's clock at write
   std::atomic<uint64_t> local_time_ns;   // this node's clock when it entered the segment
 };
-static_assert(sizeof(SlotHeader) == 32, "slot header is 4 words");
+static_assert(sizeof(SlotHeader) == 40, "slot header is 5 words");
 
 struct alignas(kCacheLine) StateCell {
   std::atomic<uint64_t> next_ticket;  // claimed tickets

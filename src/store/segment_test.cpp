@@ -7,6 +7,9 @@
 #include <stdlib.h>
 
 #include "common/platform.h"
+#include "store/reclaim.h"
+#include <sys/wait.h>
+#include <unistd.h>
 #include "store/test_config.h"
 
 namespace ccomm {
@@ -108,6 +111,41 @@ TEST_F(SegmentTest, OpenMissingOrForeignSegment) {
   bool adopted;
   ASSERT_EQ(d.CreateOrAdopt(Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
   EXPECT_EQ(c.Open(SegmentName("a")), 0);
+}
+
+// Only slots of writers that are provably dead are given back.
+TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
+  SystemConfig cfg = Cfg();
+  Segment d;
+  std::string err;
+  bool adopted;
+  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  std::vector<uint64_t> suspects(SlotCount(d), 0);
+  EXPECT_EQ(SlotCount(d), 4u + 4u + 16u);
+  // A child claims a slot like a writer and dies before completing it.
+  pid_t child = fork();
+  if (child == 0) {
+    StateView v = d.state(0);
+    uint64_t t = v.cell->next_ticket.fetch_add(1);
+    v.slot(t)->seq.store(2 * t + 1);
+    v.slot(t)->owner.store((uint64_t{platform::ProcessId()} << 32) | t);
+    _exit(0);
+  }
+  waitpid(child, nullptr, 0);
+  // This live process holds another slot of the same cell.
+  StateView v = d.state(0);
+  uint64_t t = v.cell->next_ticket.fetch_add(1);
+  v.slot(t)->seq.store(2 * t + 1);
+  v.slot(t)->owner.store((uint64_t{platform::ProcessId()} << 32) | t);
+  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 1u);
+  EXPECT_EQ(v.slot(0)->seq.load(), 0u);       // the dead child's slot: free again
+  EXPECT_EQ(v.slot(t)->seq.load(), 2 * t + 1);  // ours: untouched
+  // A writer that died before writing its owner word: freed at the second scan.
+  RingView r = d.ring(2);
+  r.slot(5)->seq.store(2 * 5 + 1);
+  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 0u);
+  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 1u);
+  EXPECT_EQ(r.slot(5)->seq.load(), 0u);
 }
 
 }  // namespace

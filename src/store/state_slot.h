@@ -9,8 +9,9 @@
 // Invariants:
 //   - The slot holding `latest` is never claimed: a newer complete copy must exist
 //     before the newest one can be overwritten, so readers always find a valid copy.
-//   - A writer killed mid-copy leaves its slot odd forever; later writers skip odd
-//     slots, readers never look at it (it never became `latest`). Nothing stalls.
+//   - A writer killed mid-copy leaves its slot odd; later writers skip odd slots,
+//     readers never look at it (it never became `latest`). Nothing stalls, and ccommd
+//     gives the slot back once it sees the writer is dead (reclaim.h).
 //   - Every loop is bounded; under absurd contention the call reports kBusy instead
 //     of spinning.
 #pragma once
@@ -18,6 +19,7 @@
 #include <atomic>
 #include <cstdint>
 
+#include "common/platform.h"
 #include "store/layout.h"
 #include "store/word_copy.h"
 
@@ -56,6 +58,7 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
     uint64_t s = h->seq.load(std::memory_order_relaxed);
     if ((s & 1) || s > 2 * t) continue;  // being written (or its writer died), or newer
     if (!h->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel)) continue;
+    h->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_release);
     uint64_t vs = value_seq ? value_seq : t + 1;
     h->value_seq.store(vs, std::memory_order_relaxed);

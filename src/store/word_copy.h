@@ -14,29 +14,18 @@ namespace store {
 
 inline void StoreWords(uint8_t* shm, const void* src, size_t len) {
   const uint8_t* s = static_cast<const uint8_t*>(src);
-  size_t i = 0;
-  for (; i + 8 <= len; i += 8) {
-    uint64_t w;
-    std::memcpy(&w, s + i, 8);
-    __atomic_store_n(reinterpret_cast<uint64_t*>(shm + i), w, __ATOMIC_RELAXED);
-  }
-  if (i < len) {
+  for (size_t i = 0; i < len; i += 8) {
     uint64_t w = 0;
-    std::memcpy(&w, s + i, len - i);
+    std::memcpy(&w, s + i, len - i < 8 ? len - i : 8);  // the tail word is zero-padded
     __atomic_store_n(reinterpret_cast<uint64_t*>(shm + i), w, __ATOMIC_RELAXED);
   }
 }
 
 inline void LoadWords(void* dst, const uint8_t* shm, size_t len) {
   uint8_t* d = static_cast<uint8_t*>(dst);
-  size_t i = 0;
-  for (; i + 8 <= len; i += 8) {
+  for (size_t i = 0; i < len; i += 8) {
     uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm + i), __ATOMIC_RELAXED);
-    std::memcpy(d + i, &w, 8);
-  }
-  if (i < len) {
-    uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm + i), __ATOMIC_RELAXED);
-    std::memcpy(d + i, &w, len - i);
+    std::memcpy(d + i, &w, len - i < 8 ? len - i : 8);
   }
 }
 

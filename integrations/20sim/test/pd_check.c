@@ -4,7 +4,7 @@
  * through ccomm: plays the plant by writing position/velocity on node ctrl, and checks
  * setpoint = ccomm_ok * (kp * (reference - position) - kd * velocity) and that
  * error_integral grows at the rate of the error, i.e. that the model runs periodically.
- * Exit 0 if every check passes.
+ * Usage: pd_check [NODE [KP]]. Exit 0 if every check passes.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <ccomm/ccomm.h>
@@ -14,7 +14,8 @@
 #include <string.h>
 #include <time.h>
 
-static const double kp = 2.0, kd = 0.5, reference = 1.0;
+static double kp = 2.0; /* argv[2] overrides: the task was started with --param kp=... */
+static const double kd = 0.5, reference = 1.0;
 static ccomm_client* c;
 static ccomm_signal s_pos, s_vel, s_sp, s_int;
 static int failures = 0;
@@ -68,6 +69,7 @@ static double read_int(uint64_t* seq) {
 
 int main(int argc, char** argv) {
   const char* node = argc > 1 ? argv[1] : "ctrl";
+  if (argc > 2) kp = atof(argv[2]);
   double deadline = now_s() + 10.0;
   int r;
   /* ccommd and the controller start in parallel: wait for the segment and the first

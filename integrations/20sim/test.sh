@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# 20-sim integration test against a real ccommd:
+#   - the C-code target: the example controller generated from its tokens file, run as a
+#     periodic task, checked as a closed loop by pd_check (also with --param kp=4),
+#     plus start-up failures for unmapped ports and unknown parameters;
+#   - the 4C component: generated from signals.xml, run by the 4C harness, same checks.
+# Usage: test.sh CCOMM_BIN_DIR [INTEGRATION_BIN_DIR]  (ccommd/ccomm, then the built tests)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+bin=$(cd "${1:?usage: test.sh CCOMM_BIN_DIR [INTEGRATION_BIN_DIR]}" && pwd)
+ibin=$(cd "${2:-$1}" && pwd)
+source "$here/../lib.sh"
+cfg=$here/example/signals.xml
+out=$(mktemp -d)
+trap 'it_cleanup; rm -rf "$out"' EXIT
+fail=0
+
+it_start_ccommd "$bin" "$cfg" ctrl
+
+echo "== 20-sim C-code target: generated PDController task"
+it_bg "$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 20 --stats-interval 0 >"$out/task.out" 2>"$out/task.err"
+task=$IT_PID
+sleep 0.2
+if command -v chrt >/dev/null; then echo "task scheduling: $(chrt -p "$task" 2>&1 | head -1)"; fi
+"$ibin/ccomm_20sim_pd_check" ctrl || fail=1
+it_stop "$task"
+cat "$out/task.out"
+if [ "$IT_RC" != 0 ]; then echo "FAIL task exit status $IT_RC"; cat "$out/task.err"; fail=1; fi
+grep -q "cycles=[1-9]" "$out/task.out" || { echo "FAIL task printed no cycle count"; fail=1; }
+
+echo "== 20-sim C-code target: --param kp=4"
+it_bg "$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 20 --param kp=4 >"$out/task2.out" 2>"$out/task2.err"
+task=$IT_PID
+"$ibin/ccomm_20sim_pd_check" ctrl 4 || fail=1
+it_stop "$task"
+[ "$IT_RC" = 0 ] || { echo "FAIL task exit status $IT_RC"; fail=1; }
+
+echo "== 20-sim C-code target: start-up errors"
+rc=0
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 1 --map position=no_such_signal >/dev/null 2>"$out/e1" || rc=$?
+if [ "$rc" = 1 ] && grep -q "input port 'position': no signal 'no_such_signal'" "$out/e1"; then
+  echo "PASS unmapped port refused: $(head -1 "$out/e1")"
+else echo "FAIL unmapped port: exit $rc: $(cat "$out/e1")"; fail=1; fi
+rc=0
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 1 --param nosuch=1 >/dev/null 2>"$out/e2" || rc=$?
+if [ "$rc" = 1 ] && grep -q "no parameter 'nosuch'; the model has: kp kd reference" "$out/e2"; then
+  echo "PASS unknown parameter refused"
+else echo "FAIL unknown parameter: exit $rc: $(cat "$out/e2")"; fail=1; fi
+rc=0
+# Output error_integral onto signal position, which input port position reads.
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 1 --map error_integral=position >/dev/null 2>"$out/e3" || rc=$?
+if [ "$rc" = 1 ] && grep -q "connected to both an input and an output" "$out/e3"; then
+  echo "PASS signal used as input and output refused"
+else echo "FAIL input/output clash: exit $rc: $(cat "$out/e3")"; fail=1; fi
+
+echo "== 20-sim C-code target: code generation for every integration method"
+for m in Discrete Euler RungeKutta2 RungeKutta4; do
+  sed "s/\[CDATA\[Euler\]\]/[CDATA[$m]]/" "$here/example/PDController_tokens.xml" >"$out/t_$m.xml"
+  python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+    --tokens "$out/t_$m.xml" --out "$out/gen_$m" >/dev/null
+  if ${CC:-cc} -std=c11 -Wall -Wextra -Wshadow -Werror -c -I"$here/../../src/include" \
+      -o "$out/$m.o" "$out/gen_$m/xxinteg.c"; then echo "PASS $m compiles"; else echo "FAIL $m"; fail=1; fi
+done
+if python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+    --tokens <(sed 's/\[CDATA\[Euler\]\]/[CDATA[BDF]]/' "$here/example/PDController_tokens.xml") \
+    --out "$out/gen_bdf" 2>"$out/e4"; then echo "FAIL unsupported method accepted"; fail=1;
+else echo "PASS unsupported method refused: $(cat "$out/e4")"; fi
+
+echo "== 20-sim 4C component: generated driver in the 4C harness"
+it_bg "$ibin/ccomm_20sim_4c_harness" >"$out/4c.out" 2>"$out/4c.err"
+h=$IT_PID
+"$ibin/ccomm_20sim_pd_check" ctrl || fail=1
+it_stop "$h"
+cat "$out/4c.out"
+[ "$IT_RC" = 0 ] || { echo "FAIL 4C harness exit status $IT_RC: $(cat "$out/4c.err")"; fail=1; }
+
+echo "== 20-sim 4C component: generator checks"
+if python3 "$here/4c/gen_4c.py" "$cfg" nosuch "$out/g" 2>"$out/e5"; then echo "FAIL unknown node accepted"; fail=1;
+else echo "PASS unknown node refused: $(cat "$out/e5")"; fi
+if CCOMM_NODE=ctrl CCOMM_GEN_20SIM4C="$here/4c/gen_4c.py" "$bin/ccomm" gen 20sim4c "$cfg" "$out/gcli" >/dev/null &&
+   grep -q '#define CCOMM4C_NODE "ctrl"' "$out/gcli/ccomm_4c.h"; then
+  echo "PASS ccomm gen 20sim4c runs the generator"
+else echo "FAIL ccomm gen 20sim4c"; fail=1; fi
+
+if [ "$fail" = 0 ]; then echo "20-sim integration: all checks passed"; else echo "20-sim integration: FAILED"; fi
+exit "$fail"

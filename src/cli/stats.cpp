@@ -80,10 +80,10 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
       bool stale = (d.flags & st::kSigConsumedHere) && d.stale_after_ms &&
                    (!last || mono - last > uint64_t{d.stale_after_ms} * 1000000);
       printf("%s{\"name\":\"%s\",\"writes\":%" PRIu64 ",\"write_errors\":%" PRIu64 ",\"tx\":%" PRIu64
-             ",\"rx\":%" PRIu64 ",\"lost\":%" PRIu64 ",\"overflow\":%" PRIu64 ",\"stale_transitions\":%" PRIu64
+             ",\"rx\":%" PRIu64 ",\"lost\":%" PRIu64 ",\"coalesced\":%" PRIu64 ",\"overflow\":%" PRIu64 ",\"stale_transitions\":%" PRIu64
              ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
              i ? "," : "", d.name, ss.writes.load(), ss.write_errors.load(), ss.tx.load(), ss.rx.load(),
-             ss.lost.load(), ss.overflow.load(), ss.stale_transitions.load(), stale ? "true" : "false",
+             ss.lost.load(), ss.coalesced.load(), ss.overflow.load(), ss.stale_transitions.load(), stale ? "true" : "false",
              before ? Rate(before->sig_rx[i], now.sig_rx[i], secs) : 0.0,
              before ? Rate(before->sig_tx[i], now.sig_tx[i], secs) : 0.0);
     }

@@ -32,6 +32,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
   last_rx_seq_.assign(n, 0);
+  last_tx_seq_.assign(n, 0);
   fresh_.assign(n, 0);
   TransportKind kind = opt.force_udp ? TransportKind::kUdp : self.transport;
   for (size_t i = 0; i < n; ++i) {

@@ -97,6 +97,7 @@ class Daemon {
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
   std::vector<uint64_t> last_rx_seq_;             // signal -> last value_seq received
+  std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
   std::vector<uint64_t> reclaim_suspects_;        // slot -> odd seq seen at the last scan

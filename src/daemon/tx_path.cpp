@@ -77,6 +77,10 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (version == 0 || (!periodic && version == sv.cell->forwarded.load(std::memory_order_relaxed))) return;
   if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) return;
   sv.cell->forwarded.store(version, std::memory_order_relaxed);
+  uint64_t& last = last_tx_seq_[id];
+  if (!periodic && last && m.value_seq > last + 1)
+    segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
+  last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 

@@ -132,6 +132,8 @@ struct alignas(kCacheLine) SignalStats {
   std::atomic<uint64_t> overflow;     // events a reader lost to ring overrun (all readers)
   std::atomic<uint64_t> stale_transitions;  // fresh -> stale seen by ccommd's supervision
   std::atomic<uint64_t> last_rx_ns;
+  std::atomic<uint64_t> coalesced;    // values replaced by a newer one before ccommd sent them
+                                      // (event-driven states when ccommd ran late)
 };
 
 struct alignas(kCacheLine) PeerStats {

@@ -38,7 +38,7 @@ const char kUsage[] =
     "      --send A,B,...     signals to write each cycle (default: doubles produced here)\n"
     "      --recv A,B,...     signals to wait for (default: doubles consumed here)\n"
     "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
-    "      --prio N           SCHED_FIFO priority for the send loop (needs CAP_SYS_NICE)\n"
+    "      --prio N           SCHED_FIFO priority for both threads (needs CAP_SYS_NICE)\n"
     "      --spin             receive by busy-polling the signals instead of ccomm_wait()\n"
     "                         (an RT loop's view: no wake-up; costs one core)\n"
     "      --cpu N            pin the receive thread to CPU N\n"
@@ -86,7 +86,7 @@ struct Shared {
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> sent{0};
   bool ping = false, echo = false, spin = false;
-  int cpu = -1;
+  int cpu = -1, prio = 0;
   uint64_t warmup_until = 0;
   std::vector<int64_t> samples;
   uint64_t first_k = 0, last_k = 0, received = 0;
@@ -105,6 +105,11 @@ void* Receiver(void* arg) {
   std::vector<double> got(n, -1);
   std::vector<uint64_t> src(n, 0);
   double last_complete = -1;
+  if (s->prio > 0) {
+    struct sched_param sp = {};
+    sp.sched_priority = s->prio;
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);  // best effort, reported by main
+  }
   if (s->cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);
@@ -113,7 +118,6 @@ void* Receiver(void* arg) {
   }
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
-    uint64_t now = Now();
     bool changed = false;
     for (size_t i = 0; i < n; ++i) {
       double v;
@@ -127,6 +131,7 @@ void* Receiver(void* arg) {
       }
     }
     if (!changed || n == 0) continue;
+    const uint64_t now = Now();  // after the reads: every value seen was written before it
     double k = got[0];
     bool complete = k > last_complete;
     uint64_t latest_src = 0;
@@ -231,6 +236,7 @@ int main(int argc, char** argv) {
   s.echo = o.mode == "echo";
   s.spin = o.spin;
   s.cpu = o.cpu;
+  s.prio = o.prio;
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort

@@ -67,6 +67,15 @@ if python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --ta
     --out "$out/gen_bdf" 2>"$out/e4"; then echo "FAIL unsupported method accepted"; fail=1;
 else echo "PASS unsupported method refused: $(cat "$out/e4")"; fi
 
+echo "== 20-sim C-code target: the generated project builds with its own CMakeLists.txt"
+python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+  --tokens "$here/example/PDController_tokens.xml" --out "$out/user" >/dev/null
+if cmake -S "$out/user" -B "$out/user/build" -DCCOMM_INCLUDE_DIR="$here/../../src/include" \
+     -DCCOMM_LIBRARY="$(cd "$bin/../lib" && pwd)/libccomm.so" >/dev/null &&
+   cmake --build "$out/user/build" >/dev/null && "$out/user/build/PDController_ccomm" --help | grep -q "Inputs: 3, outputs: 2"; then
+  echo "PASS generated project builds and runs (--help)"
+else echo "FAIL generated project build"; fail=1; fi
+
 echo "== 20-sim 4C component: generated driver in the 4C harness"
 it_bg "$ibin/ccomm_20sim_4c_harness" >"$out/4c.out" 2>"$out/4c.err"
 h=$IT_PID

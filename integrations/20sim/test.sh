@@ -54,6 +54,33 @@ if [ "$rc" = 1 ] && grep -q "connected to both an input and an output" "$out/e3"
   echo "PASS signal used as input and output refused"
 else echo "FAIL input/output clash: exit $rc: $(cat "$out/e3")"; fail=1; fi
 
+echo "== 20-sim C-code target: vector ports and an event input (VectorGain)"
+it_bg "$ibin/ccomm_20sim_vectorgain" --node ctrl --priority 20 >"$out/vg.out" 2>"$out/vg.err"
+vg=$IT_PID
+expect() {  # expect SIGNAL PATTERN WHAT: polls `ccomm echo --once` for up to 2 s
+  local got="" i
+  for i in $(seq 40); do
+    got=$("$bin/ccomm" --node ctrl echo "$1" --once 2>&1) || true
+    if grep -qE "$2" <<<"$got"; then echo "PASS $3: $got"; return 0; fi
+    sleep 0.05
+  done
+  echo "FAIL $3: $got (want $2)"
+  fail=1
+}
+"$bin/ccomm" --node ctrl pub vin 1.3 2 -3.2
+expect vout '^vout \[3, 4, -6\] fresh' "vin[1..3] -> vout[1..3] = 2*vin, rounded to int32"
+"$bin/ccomm" --node ctrl pub vin 1e12 0 0
+expect vout '^vout \[2147483647, 0, 0\] fresh' "int32 output saturates"
+"$bin/ccomm" --node ctrl pub cmd 5
+expect last_cmd '^last_cmd 5 fresh' "event input reaches the model"
+sleep 0.2
+expect last_cmd '^last_cmd 5 fresh' "event input holds between events"
+"$bin/ccomm" --node ctrl pub cmd 7
+"$bin/ccomm" --node ctrl pub cmd 9
+expect last_cmd '^last_cmd 9 fresh' "newest of two events"
+it_stop "$vg"
+[ "$IT_RC" = 0 ] || { echo "FAIL VectorGain exit status $IT_RC: $(cat "$out/vg.err")"; fail=1; }
+
 echo "== 20-sim C-code target: code generation for every integration method"
 for m in Discrete Euler RungeKutta2 RungeKutta4; do
   sed "s/\[CDATA\[Euler\]\]/[CDATA[$m]]/" "$here/example/PDController_tokens.xml" >"$out/t_$m.xml"

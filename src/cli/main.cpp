@@ -232,7 +232,7 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
   return 0;
 }
 
-int CmdGen(int argc, char** argv) {
+int CmdGen(const char* node, int argc, char** argv) {
   if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
     fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
     return 2;
@@ -244,6 +244,12 @@ int CmdGen(int argc, char** argv) {
   std::string py = "python3";
   args.push_back(&py[0]);
   args.push_back(&path[0]);
+  std::string node_opt = "--node";
+  std::string node_name = node ? node : "";
+  if (node) {
+    args.push_back(&node_opt[0]);
+    args.push_back(&node_name[0]);
+  }
   for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
   args.push_back(nullptr);
   execvp("python3", args.data());
@@ -275,7 +281,7 @@ int main(int argc, char** argv) {
   const char* cmd = argv[optind];
   int sub_argc = argc - optind;
   char** sub_argv = argv + optind;
-  if (strcmp(cmd, "gen") == 0) return CmdGen(sub_argc, sub_argv);
+  if (strcmp(cmd, "gen") == 0) return CmdGen(node, sub_argc, sub_argv);
   if (strcmp(cmd, "help") == 0) { fputs(kUsage, stdout); return 0; }
   if (strcmp(cmd, "list") && strcmp(cmd, "echo") && strcmp(cmd, "pub") && strcmp(cmd, "stats")) {
     fprintf(stderr, "ccomm: unknown command '%s'\n%s", cmd, kUsage);

@@ -63,11 +63,11 @@ inline StoreResult RingWrite(const RingView& v, const void* value, uint64_t valu
       !s->seq.compare_exchange_strong(prev, 2 * h + 1, std::memory_order_acq_rel))
     return StoreResult::kBusy;  // ticket h stays a hole; readers skip it after a timeout
   s->owner.store((uint64_t{platform::ProcessId()} << 32) | (h & 0xffffffffu), std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
+  SeqlockWriterFence();
   uint64_t vs = value_seq ? value_seq : h + 1;
-  s->value_seq.store(vs, std::memory_order_relaxed);
-  s->source_time_ns.store(source_time_ns, std::memory_order_relaxed);
-  s->local_time_ns.store(local_time_ns, std::memory_order_relaxed);
+  s->value_seq.store(vs, kMetaStore);
+  s->source_time_ns.store(source_time_ns, kMetaStore);
+  s->local_time_ns.store(local_time_ns, kMetaStore);
   StoreWords(reinterpret_cast<uint8_t*>(s + 1), value, v.value_bytes);
   s->seq.store(2 * h + 2, std::memory_order_release);
   if (seq_out) *seq_out = vs;
@@ -96,11 +96,11 @@ inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMet
     const SlotHeader* s = v.slot(t);
     uint64_t s1 = s->seq.load(std::memory_order_acquire);
     if (s1 == 2 * t + 2) {
-      meta->value_seq = s->value_seq.load(std::memory_order_relaxed);
-      meta->source_time_ns = s->source_time_ns.load(std::memory_order_relaxed);
-      meta->local_time_ns = s->local_time_ns.load(std::memory_order_relaxed);
+      meta->value_seq = s->value_seq.load(kMetaLoad);
+      meta->source_time_ns = s->source_time_ns.load(kMetaLoad);
+      meta->local_time_ns = s->local_time_ns.load(kMetaLoad);
       LoadWords(out, reinterpret_cast<const uint8_t*>(s + 1), v.value_bytes);
-      std::atomic_thread_fence(std::memory_order_acquire);
+      SeqlockReaderFence();
       if (s->seq.load(std::memory_order_relaxed) == s1) {
         c->next = t + 1;
         c->stuck_since = 0;

@@ -59,11 +59,11 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
     if ((s & 1) || s > 2 * t) continue;  // being written (or its writer died), or newer
     if (!h->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel)) continue;
     h->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
+    SeqlockWriterFence();
     uint64_t vs = value_seq ? value_seq : t + 1;
-    h->value_seq.store(vs, std::memory_order_relaxed);
-    h->source_time_ns.store(source_time_ns, std::memory_order_relaxed);
-    h->local_time_ns.store(local_time_ns, std::memory_order_relaxed);
+    h->value_seq.store(vs, kMetaStore);
+    h->source_time_ns.store(source_time_ns, kMetaStore);
+    h->local_time_ns.store(local_time_ns, kMetaStore);
     StoreWords(reinterpret_cast<uint8_t*>(h + 1), value, v.value_bytes);
     h->seq.store(2 * t + 2, std::memory_order_release);
     // Publish: raise latest to t+1 unless a newer copy is already published. Each
@@ -89,11 +89,11 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
     const SlotHeader* h = v.slot(t);
     uint64_t s1 = h->seq.load(std::memory_order_acquire);
     if (s1 != 2 * t + 2) continue;
-    meta->value_seq = h->value_seq.load(std::memory_order_relaxed);
-    meta->source_time_ns = h->source_time_ns.load(std::memory_order_relaxed);
-    meta->local_time_ns = h->local_time_ns.load(std::memory_order_relaxed);
+    meta->value_seq = h->value_seq.load(kMetaLoad);
+    meta->source_time_ns = h->source_time_ns.load(kMetaLoad);
+    meta->local_time_ns = h->local_time_ns.load(kMetaLoad);
     LoadWords(out, reinterpret_cast<const uint8_t*>(h + 1), v.value_bytes);
-    std::atomic_thread_fence(std::memory_order_acquire);
+    SeqlockReaderFence();
     if (h->seq.load(std::memory_order_relaxed) == s1) return StoreResult::kOk;
   }
   return StoreResult::kBusy;

@@ -8,7 +8,7 @@ from harness import ROOT, NodePair
 LOCAL = """<?xml version="1.0"?>
 <ccomm version="1">
   <node name="control" interface="eth0"/>
-  <signal name="camera_x" type="double" producer="control" stale_after_ms="100"/>
+  <signal name="camera_x" type="double" producer="control" stale_after_ms="5000"/>
   <signal name="targets" type="float" count="4" producer="control"/>
   <signal name="estop" type="bool" kind="event" producer="control"/>
 </ccomm>

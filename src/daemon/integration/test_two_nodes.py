@@ -31,8 +31,12 @@ def test_setup_simulation_both_ways(transport):
         assert lat
         for r, sent_by_peer in ((ra, rb["sent"]), (rb, ra["sent"])):
             assert r["count"] > 1000, r
-            # Loss must be small even on a loaded 2-core CI machine.
-            assert r["lost"] <= 0.02 * sent_by_peer, r
+            # Cycles the app did not see complete: on a loaded 2-core machine a late reader or
+            # a late ccommd lets a newer value replace an older one (state semantics); bounded.
+            assert r["lost"] <= 0.10 * sent_by_peer, r
+        # On the wire nothing may be lost: a veth pair does not drop frames.
+        for node, peer in (("control", "planner"), ("planner", "control")):
+            assert peer_stats(pair.stats(node), peer)["frames_lost"] == 0
         assert ra["send_signals"] == 36 and rb["send_signals"] == 9
         st = pair.stats("planner")
         assert signal_stats(st, "wheel0_pos")["rx"] >= 1500

@@ -179,6 +179,12 @@ int Segment::Open(const std::string& name) {
   platform::CloseFd(fd);
   if (r != 0) return r;
   auto* h = static_cast<SegmentHeader*>(p);
+  if (h->magic == 0) {
+    // ccommd is creating it: ftruncate zero-fills, the header is copied in next. Not a
+    // foreign segment; a client retrying now must not give up with "version mismatch".
+    platform::Unmap(p, size);
+    return -ENOENT;
+  }
   if (h->magic != kSegmentMagic || h->layout_version != kLayoutVersion || h->size != size) {
     platform::Unmap(p, size);
     return -EPROTO;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "common/platform.h"
 #include "store/reclaim.h"
@@ -104,7 +105,17 @@ TEST_F(SegmentTest, OpenMissingOrForeignSegment) {
   ASSERT_GE(fd, 0);
   ASSERT_EQ(platform::Truncate(fd, 4096), 0);
   platform::CloseFd(fd);
-  EXPECT_EQ(c.Open(SegmentName("a")), -EPROTO);  // zeros: not our magic
+  // Zeros: what ccommd's segment looks like between ftruncate and filling it in. A
+  // client must keep waiting (-ENOENT), not conclude the layout differs (-EPROTO).
+  EXPECT_EQ(c.Open(SegmentName("a")), -ENOENT);
+  fd = platform::ShmOpen(SegmentName("a").c_str(), false, 0);
+  ASSERT_GE(fd, 0);
+  void* p = platform::MapShared(fd, 4096);
+  ASSERT_NE(p, nullptr);
+  memset(p, 0xA5, 64);  // something else's data: not our magic
+  platform::Unmap(p, 4096);
+  platform::CloseFd(fd);
+  EXPECT_EQ(c.Open(SegmentName("a")), -EPROTO);
   // The daemon replaces a foreign or half-created segment.
   Segment d;
   std::string err;

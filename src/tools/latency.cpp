@@ -36,9 +36,12 @@ const char kUsage[] =
     "  -d, --duration SEC     how long to run (default 10)\n"
     "  -m, --mode MODE        oneway (default), ping, or echo (reply to a ping peer)\n"
     "      --send A,B,...     signals to write each cycle (default: doubles produced here)\n"
-    "      --recv A,B,...     signals to wait for (default: doubles consumed here)\n"
+    "      --recv A,B,...     signals to wait for (default: doubles consumed here); event\n"
+    "                         signals named here are drained, the newest one counts\n"
     "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
     "      --prio N           SCHED_FIFO priority for both threads (needs CAP_SYS_NICE)\n"
+    "      --rx-prio N        the receive thread's priority instead (e.g. below --prio with\n"
+    "                         --spin, so a spinning receiver never starves the sender)\n"
     "      --spin             receive by busy-polling the signals instead of ccomm_wait()\n"
     "                         (an RT loop's view: no wake-up; costs one core)\n"
     "      --cpu N            pin the receive thread to CPU N\n"
@@ -52,7 +55,7 @@ struct Options {
   double rate = 1000, duration = 10, warmup = 0.5;
   std::string mode = "oneway", label = "ccomm", samples_file;
   std::string send, recv;
-  int prio = 0;
+  int prio = 0, rx_prio = -1;
   bool spin = false;
   int cpu = -1;
 };
@@ -105,6 +108,20 @@ void* Receiver(void* arg) {
   std::vector<double> got(n, -1);
   std::vector<uint64_t> src(n, 0);
   double last_complete = -1;
+  std::vector<bool> is_event(n, false);
+  for (size_t i = 0; i < n; ++i) {
+    ccomm_signal_desc d;
+    is_event[i] = ccomm_describe(s->rx_client, s->recv[i], &d) == 0 && d.is_event;
+    // Only values written after we started count: a value left in the segment by an
+    // earlier run (its k restarted from 1 since) would otherwise block completion.
+    double v;
+    ccomm_info info;
+    int r;
+    while ((r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info)) == CCOMM_FRESH || r == CCOMM_STALE) {
+      last_seq[i] = info.seq;
+      if (!is_event[i]) break;
+    }
+  }
   if (s->prio > 0) {
     struct sched_param sp = {};
     sp.sched_priority = s->prio;
@@ -123,11 +140,15 @@ void* Receiver(void* arg) {
       double v;
       ccomm_info info;
       int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
-      if ((r == CCOMM_FRESH || r == CCOMM_STALE) && info.seq != last_seq[i]) {
+      // Events queue: take every one waiting, keep the newest (one wake-up may find
+      // several, and leaving them queued would delay every later sample).
+      while ((r == CCOMM_FRESH || r == CCOMM_STALE) && info.seq != last_seq[i]) {
         last_seq[i] = info.seq;
         got[i] = v;
         src[i] = info.source_time_ns;
         changed = true;
+        if (!is_event[i]) break;
+        r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
       }
     }
     if (!changed || n == 0) continue;
@@ -197,6 +218,7 @@ int main(int argc, char** argv) {
       {"duration", required_argument, nullptr, 'd'}, {"mode", required_argument, nullptr, 'm'},
       {"send", required_argument, nullptr, 'S'},   {"recv", required_argument, nullptr, 'R'},
       {"warmup", required_argument, nullptr, 'W'}, {"prio", required_argument, nullptr, 'P'},
+      {"rx-prio", required_argument, nullptr, 'Q'},
       {"label", required_argument, nullptr, 'L'},  {"samples", required_argument, nullptr, 'F'},
       {"spin", no_argument, nullptr, 'X'},         {"cpu", required_argument, nullptr, 'C'},
       {"help", no_argument, nullptr, 'h'},         {nullptr, 0, nullptr, 0}};
@@ -211,6 +233,7 @@ int main(int argc, char** argv) {
       case 'R': o.recv = optarg; break;
       case 'W': o.warmup = atof(optarg); break;
       case 'P': o.prio = atoi(optarg); break;
+      case 'Q': o.rx_prio = atoi(optarg); break;
       case 'L': o.label = optarg; break;
       case 'F': o.samples_file = optarg; break;
       case 'X': o.spin = true; break;
@@ -236,7 +259,7 @@ int main(int argc, char** argv) {
   s.echo = o.mode == "echo";
   s.spin = o.spin;
   s.cpu = o.cpu;
-  s.prio = o.prio;
+  s.prio = o.rx_prio >= 0 ? o.rx_prio : o.prio;
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort

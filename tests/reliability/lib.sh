@@ -1,0 +1,204 @@
+# SPDX-License-Identifier: Apache-2.0
+# Shared helpers of the reliability tests (sourced). Network namespaces named
+# rel<pid>-<x>, daemons and helpers started here are tracked by pid and removed on exit.
+#
+# Environment:
+#   CCOMM_BUILD_DIR   build with bin/ccommd, bin/ccomm, lib/libccomm.so (default build-rel)
+#   REL_KEEP_LOGS=1   keep the work directory (logs) after the test
+set -uo pipefail
+
+REL_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+ROOT=$(cd "$REL_DIR/../.." && pwd)
+BUILD=${CCOMM_BUILD_DIR:-$ROOT/build-rel}
+[[ $BUILD = /* ]] || BUILD=$ROOT/$BUILD
+BIN=$BUILD/bin
+CONFIG=$REL_DIR/reliability.xml
+TAG=rel$$
+export CCOMM_SHM_PREFIX=/$TAG.
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/ccomm-$TAG-XXXXXX")
+TESTNUM=0
+FAILED=0
+PIDS=()
+NAMESPACES=()
+
+# ---- TAP-ish output ------------------------------------------------------------------
+ok() { TESTNUM=$((TESTNUM + 1)); echo "ok $TESTNUM - $*"; }
+not_ok() { TESTNUM=$((TESTNUM + 1)); FAILED=$((FAILED + 1)); echo "not ok $TESTNUM - $*"; }
+check() {  # check "description" command...: ok if the command succeeds
+  local d=$1; shift
+  if "$@"; then ok "$d"; else not_ok "$d"; fi
+}
+figure() { echo "# figure: $*"; }
+note() { echo "# $*"; }
+skip_all() { echo "1..0 # SKIP $*"; exit 4; }
+finish() {
+  echo "1..$TESTNUM"
+  [[ $FAILED -eq 0 ]] && exit 0
+  echo "# $FAILED of $TESTNUM failed; logs in $WORK" >&2
+  REL_KEEP_LOGS=1
+  exit 1
+}
+
+require_root() {
+  [[ $(id -u) -eq 0 ]] || skip_all "needs root (network namespaces, raw sockets)"
+  command -v ip >/dev/null || skip_all "needs iproute2"
+}
+require_build() {
+  for b in ccommd ccomm; do
+    [[ -x $BIN/$b ]] || { echo "Bail out! $BIN/$b missing: build first or set CCOMM_BUILD_DIR"; exit 1; }
+  done
+}
+
+# ---- helpers compiled from tests/reliability/*.c ----------------------------------------
+build_tool() {  # build_tool NAME [extra cc args]: compiles NAME.c into $WORK/NAME
+  local name=$1; shift
+  cc -O2 -Wall -Wextra -Werror -o "$WORK/$name" "$REL_DIR/$name.c" "$@" ||
+    { echo "Bail out! cannot compile $name.c"; exit 1; }
+}
+build_torture() {
+  build_tool torture -I"$ROOT/src/include" -L"$BUILD/lib" -lccomm -Wl,-rpath,"$BUILD/lib"
+}
+
+# ---- cleanup -----------------------------------------------------------------------
+cleanup() {
+  local p
+  for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null; done
+  local ns
+  for ns in "${NAMESPACES[@]}"; do ip netns del "$ns" 2>/dev/null; done
+  rm -f /dev/shm/"$TAG".* 2>/dev/null
+  if [[ ${REL_KEEP_LOGS:-0} = 1 ]]; then echo "# logs kept in $WORK" >&2; else rm -rf "$WORK"; fi
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+
+# spawn LOGFILE NODE command...: runs command in NODE's namespace in the background.
+# `ip netns exec` execs the command, so $! (also kept in PIDS) is the command itself and
+# a signal to it reaches the program, not a wrapper shell.
+spawn() {
+  local log=$1 ns
+  ns=$(ns_of "$2")
+  ip netns exec "$ns" "${@:3}" >"$log" 2>&1 &
+  PIDS+=($!)
+}
+
+# ---- namespaces ---------------------------------------------------------------------
+ns_new() {  # ns_new NAME: a namespace with lo up and IPv6 off (no stray ND/MLD frames)
+  ip netns add "$1" || { echo "Bail out! ip netns add $1"; exit 1; }
+  NAMESPACES+=("$1")
+  ip -n "$1" link set lo up
+  ip netns exec "$1" sysctl -qw net.ipv6.conf.all.disable_ipv6=1 net.ipv6.conf.default.disable_ipv6=1
+}
+ns_up_eth0() {  # ns_up_eth0 NS IP
+  ip -n "$1" addr add "$2/24" dev eth0
+  ip netns exec "$1" sysctl -qw net.ipv6.conf.eth0.disable_ipv6=1
+  ip -n "$1" link set eth0 up
+}
+# control (NS_C, 10.42.0.1) and planner (NS_P, 10.42.0.2) joined by one veth pair.
+make_pair() {
+  NS_C=$TAG-c NS_P=$TAG-p
+  ns_new "$NS_C"
+  ns_new "$NS_P"
+  ip link add eth0 netns "$NS_C" type veth peer name eth0 netns "$NS_P"
+  ns_up_eth0 "$NS_C" 10.42.0.1
+  ns_up_eth0 "$NS_P" 10.42.0.2
+  static_neighbours
+}
+# Same, with a middle namespace NS_M bridging them through $WORK/impair (m0 <-> m1).
+make_impaired_pair() {
+  NS_C=$TAG-c NS_P=$TAG-p NS_M=$TAG-m
+  ns_new "$NS_C"
+  ns_new "$NS_P"
+  ns_new "$NS_M"
+  ip link add eth0 netns "$NS_C" type veth peer name m0 netns "$NS_M"
+  ip link add eth0 netns "$NS_P" type veth peer name m1 netns "$NS_M"
+  ns_up_eth0 "$NS_C" 10.42.0.1
+  ns_up_eth0 "$NS_P" 10.42.0.2
+  ip -n "$NS_M" link set m0 up
+  ip -n "$NS_M" link set m1 up
+  static_neighbours
+}
+# Permanent neighbour entries: no ARP frames, so an interface's rx counter holds only
+# ccomm traffic (UDP included) and the counts can be compared exactly.
+static_neighbours() {
+  local mac_c mac_p
+  mac_c=$(ip netns exec "$NS_C" cat /sys/class/net/eth0/address)
+  mac_p=$(ip netns exec "$NS_P" cat /sys/class/net/eth0/address)
+  ip -n "$NS_C" neigh replace 10.42.0.2 lladdr "$mac_p" dev eth0 nud permanent
+  ip -n "$NS_P" neigh replace 10.42.0.1 lladdr "$mac_c" dev eth0 nud permanent
+}
+ns_of() { [[ $1 = control ]] && echo "$NS_C" || echo "$NS_P"; }
+
+# ---- daemons and clients ------------------------------------------------------------------
+declare -A DPID
+start_daemon() {  # start_daemon NODE [extra ccommd args]: waits until its segment is ready
+  local node=$1; shift
+  local log=$WORK/ccommd-$node.log
+  ip netns exec "$(ns_of "$node")" "$BIN/ccommd" --node "$node" --no-rt -c "${DAEMON_CONFIG:-$CONFIG}" "$@" \
+    >>"$log" 2>&1 &
+  DPID[$node]=$!
+  PIDS+=($!)
+  local i
+  for i in $(seq 100); do
+    if cli "$node" stats --json 2>/dev/null | grep -q '"daemon_alive":true'; then return 0; fi
+    kill -0 "${DPID[$node]}" 2>/dev/null || { echo "# ccommd $node exited:"; sed 's/^/#   /' "$log"; return 1; }
+    sleep 0.05
+  done
+  echo "# ccommd $node not ready after 5 s"
+  return 1
+}
+stop_daemon() {  # SIGTERM, wait; returns ccommd's exit status
+  local p=${DPID[$1]}
+  kill -TERM "$p" 2>/dev/null
+  wait "$p" 2>/dev/null
+}
+daemon_alive() { kill -0 "${DPID[$1]}" 2>/dev/null; }
+cli() { local node=$1; shift; ip netns exec "$(ns_of "$node")" "$BIN/ccomm" --node "$node" "$@"; }
+in_ns() { local node=$1; shift; ip netns exec "$(ns_of "$node")" "$@"; }
+
+# stats NODE: ccomm stats --json into $WORK/stats-NODE.json; jq-free accessors below.
+# (--watch prints its first snapshot after 5 ms; a one-shot stats waits 200 ms for rates.)
+stats() { stats_json "$1" >"$WORK/stats-$1.json"; }
+stats_json() { cli "$1" stats --json --watch 0.005 | head -n1; }
+# counter NODE NAME: a daemon counter from the last stats NODE
+counter() {
+  python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["counters"][sys.argv[2]])' \
+    "$WORK/stats-$1.json" "$2"
+}
+# peer NODE FIELD: a field of the (only) peer of NODE from the last stats NODE
+peer() {
+  python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))["peers"][0]; v=p[sys.argv[2]]
+print(str(v).lower() if isinstance(v,bool) else v)' "$WORK/stats-$1.json" "$2"
+}
+# rss PID: "VmRSS VmHWM" in kB
+rss() { awk '/^VmRSS/{r=$2} /^VmHWM/{h=$2} END{print r, h}' "/proc/$1/status"; }
+# sock_drops NODE: packets dropped at ccommd's socket(s) (receive buffer full), from ss
+sock_drops() {
+  local pid=${DPID[$1]}
+  in_ns "$1" ss -a -n -p -m -0 -u 2>/dev/null | awk -v p="pid=$pid," '
+    index($0, p) {want=1} want && /skmem/ {match($0, /,d[0-9]+\)/); s+=substr($0, RSTART+2, RLENGTH-3); want=0}
+    END {print s+0}'
+}
+rx_packets() { in_ns "$1" cat "/sys/class/net/${2:-eth0}/statistics/rx_packets"; }
+tx_dropped() { in_ns "$1" cat "/sys/class/net/${2:-eth0}/statistics/tx_dropped"; }
+# frames_total NODE: every frame ccommd looked at ends in exactly one of these counters.
+frames_total() {
+  python3 -c 'import json,sys; c=json.load(open(sys.argv[1]))["counters"]
+print(sum(c[k] for k in ("frames_rx","frames_bad","frames_wrong_hash","frames_unknown_sender",
+                         "frames_auth_failed","frames_replayed","frames_not_for_us")))' "$WORK/stats-$1.json"
+}
+# snapshot NODE: stats NODE plus SNAP_RX (eth0 rx_packets) and SNAP_DROPS (socket drops),
+# taken while no frame arrives (rx_packets equal before and after), so that they agree.
+snapshot() {
+  local i a b
+  for i in $(seq 40); do
+    a=$(rx_packets "$1"); stats "$1"; SNAP_DROPS=$(sock_drops "$1"); b=$(rx_packets "$1")
+    [[ $a = "$b" ]] && { SNAP_RX=$a; return 0; }
+  done
+  SNAP_RX=$b
+  echo "# snapshot of $1 not quiescent after 40 tries"
+  return 1
+}
+json_get() {  # json_get FILE KEY: a top-level field of the last JSON line of FILE
+  python3 -c 'import json,sys; print(json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])[sys.argv[2]])' "$1" "$2"
+}

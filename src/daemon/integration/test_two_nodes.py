@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from harness import BIN, NodePair, peer_stats, signal_stats
+from harness import BIN, SANITIZED, NodePair, peer_stats, signal_stats
 
 
 @pytest.mark.parametrize("transport", [None, "udp"], ids=["raw", "udp"])
@@ -30,6 +30,9 @@ def test_setup_simulation_both_ways(transport):
         rb = json.loads(b.communicate(timeout=30)[0])
         assert lat
         for r, sent_by_peer in ((ra, rb["sent"]), (rb, ra["sent"])):
+            if SANITIZED:  # slow build: only that every direction works
+                assert r["count"] > 100, r
+                continue
             assert r["count"] > 1000, r
             # Cycles the app did not see complete: on a loaded 2-core machine a late reader or
             # a late ccommd lets a newer value replace an older one (state semantics); bounded.
@@ -39,7 +42,7 @@ def test_setup_simulation_both_ways(transport):
             assert peer_stats(pair.stats(node), peer)["frames_lost"] == 0
         assert ra["send_signals"] == 36 and rb["send_signals"] == 9
         st = pair.stats("planner")
-        assert signal_stats(st, "wheel0_pos")["rx"] >= 1500
+        assert signal_stats(st, "wheel0_pos")["rx"] >= (200 if SANITIZED else 1500)
         assert peer_stats(st, "control")["alive"]
         assert st["counters"]["frames_bad"] == 0
         # One frame per cycle: control sent 36 doubles per cycle in (about) one frame each.

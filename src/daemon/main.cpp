@@ -15,6 +15,7 @@
 #include "common/platform.h"
 #include "config/config.h"
 #include "daemon/daemon.h"
+#include "daemon/privileges.h"
 #include "daemon/sd_notify.h"
 
 // Hooks for the allocation-counting test (tests/alloc_counter.cpp preloads them);
@@ -152,6 +153,13 @@ int main(int argc, char** argv) {
   Log(LogLevel::kInfo, "ccommd %s: node '%s', %zu signals, transport %s, segment %s (%s), config hash %08x",
       CCOMM_VERSION, self.name.c_str(), cfg.signals.size(), daemon.transport_name(),
       store::SegmentName(self.name).c_str(), daemon.adopted_segment() ? "re-adopted" : "created", cfg.hash);
+
+  // Socket open, segment created, memory locked: no capability is needed any more. The
+  // I/O threads created next inherit the reduced sets (privileges.h).
+  std::string privileges;
+  r = DropPrivileges(self.realtime, !opt.no_realtime, &privileges);
+  if (r != 0) Log(LogLevel::kWarning, "cannot drop capabilities: %s", strerror(-r));
+  else Log(LogLevel::kInfo, "%s", privileges.c_str());
 
   pthread_t tx, rx;
   pthread_create(&tx, nullptr, TxThread, &daemon);

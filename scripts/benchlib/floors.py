@@ -162,8 +162,10 @@ class Context:
 
     def common(self, case):
         raw = os.path.join(self.rawdir, case.name + ".tsv")
+        # opts["half"]: report RTT/2 (ping-pong peers compared with one-way figures).
+        half = ["--half"] if case.opts.get("half") else []
         return ["--name", case.name, "--payload", str(case.payload), "--rate", "%g" % case.rate,
-                "--count", str(case.count), "--warmup", str(self.warmup), "--dump", raw]
+                "--count", str(case.count), "--warmup", str(self.warmup)] + half + ["--dump", raw]
 
     def log(self, case, what):
         return os.path.join(self.logdir, "%s.%s.log" % (case.name, what))

@@ -1,0 +1,126 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Tests of scripts/bench's own logic (run from scripts/):
+
+    CCOMM_BUILD_DIR=<build tree> python3 -m unittest -v benchlib.test_bench
+
+The configuration tests need ccommd (skipped when it is not built).
+"""
+
+import os
+import subprocess
+import tempfile
+import unittest
+
+from . import ccomm, procs, report, results, suite
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+
+
+def _ccommd():
+    for d in (os.environ.get("CCOMM_BUILD_DIR"), os.path.join(REPO, "build-perf"), os.path.join(REPO, "build")):
+        if d and os.path.exists(os.path.join(d, "bin", "ccommd")):
+            return os.path.join(d, "bin", "ccommd")
+    return None
+
+
+class ConfigTest(unittest.TestCase):
+    def check(self, text):
+        exe = _ccommd()
+        if not exe:
+            self.skipTest("ccommd not built")
+        with tempfile.NamedTemporaryFile("w", suffix=".xml") as f:
+            f.write(text)
+            f.flush()
+            cp = subprocess.run([exe, "--check", f.name], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.assertEqual(cp.returncode, 0, cp.stdout)
+        return cp.stdout
+
+    def test_pair_configs_are_valid(self):
+        ns = procs.NetnsPair("x")
+        for periodic in (0, 100, 10000):
+            for transport in ("raw", "udp"):
+                text = ccomm.pair_config(("control", "planner"), ccomm.SETUP_A2B, ccomm.SETUP_B2A, transport, ns,
+                                         periodic, 80, (0, 1))
+                out = self.check(text)
+                self.assertIn("2 nodes, 45 signals", out)
+                self.assertEqual(text.count('rate_hz="%g"' % periodic), 45 if periodic else 0)
+
+    def test_local_config_is_valid(self):
+        out = self.check(ccomm.local_config(80, 0))
+        self.assertIn("1 nodes, 37 signals", out)
+
+    def test_setup_names_match_default_config(self):
+        with open(os.path.join(REPO, "dist", "signals.xml")) as f:
+            text = f.read()
+        for name in ccomm.SETUP_A2B + ccomm.SETUP_B2A:
+            self.assertIn('name="%s"' % name, text)
+
+
+class CallgrindTest(unittest.TestCase):
+    def test_calls_summed_over_call_sites(self):
+        text = "\n".join([
+            "events: Ir", "fl=(1) a.cpp", "fn=(1) main", "10 5",
+            "cfn=(2) ccomm::Daemon::HandleFrame(unsigned char const*)", "calls=3 20", "11 300",
+            "fn=(3) other", "cfn=(2)", "calls=1 20", "+2 150",
+            "fn=(2)", "20 100", "totals: 555", ""])
+        with tempfile.NamedTemporaryFile("w", suffix=".cg") as f:
+            f.write(text)
+            f.flush()
+            calls = ccomm.callgrind_calls(f.name)
+            self.assertEqual(ccomm.callgrind_total(f.name), 555)
+        self.assertEqual(calls["ccomm::Daemon::HandleFrame(unsigned char const*)"], [4, 450])
+        self.assertEqual(ccomm.per_call(calls, [("rx", "HandleFrame(")]), [("rx", 4, 112.5)])
+
+
+class MergeTest(unittest.TestCase):
+    def test_halves_join(self):
+        with tempfile.TemporaryDirectory() as d:
+            os.makedirs(os.path.join(d, "raw"))
+            rows = []
+            for i, vals in enumerate(([10, 20], [30, 40, 50]), 1):
+                name = "ccomm_x" + suite.REPEAT % i
+                with open(os.path.join(d, "raw", name + ".tsv"), "w") as f:
+                    f.write("".join("%d\t%d\n" % (k, v) for k, v in enumerate(vals)))
+                rows.append(results.row_from_samples(name, "raw", 8, 1000, vals, i, raw="raw/%s.tsv" % name,
+                                                     sent=10 * i, wire={"data_frames": 10 * i, "frames_lost": 0}))
+            rows.append(results.row_from_samples("other", "raw", 8, 1000, [1], 0))
+            out = suite.merge_repeats(rows, d)
+            self.assertEqual([r["name"] for r in out], ["ccomm_x", "other"])
+            m = out[0]
+            self.assertEqual((m["count"], m["lost"], m["min_ns"], m["max_ns"], m["p50_ns"]), (5, 3, 10, 50, 30))
+            self.assertEqual(m["sent"], 30)
+            self.assertEqual(m["frames_per_cycle"], 1.0)
+            self.assertEqual(len(results.load_raw(os.path.join(d, m["raw"]))), 5)
+
+
+class ReportTest(unittest.TestCase):
+    def rows(self, ccomm_p50, floor_p50):
+        mk = results.row_from_samples
+        return [
+            dict(mk("net_raw_oneway_1khz_p8", "raw", 8, 1000, [floor_p50], 0, metric="one_way"), section="b2b"),
+            dict(mk("ccomm_raw_oneway_block_1khz_p8", "raw", 8, 1000, [ccomm_p50], 0, metric="one_way"),
+                 section="b2b", style="block"),
+            dict(mk("thesis_setup_event_10khz_a2b", "raw", 288, 10000, [50000], 0), section="thesis", exp="setup",
+                 mode="event", direction="a2b", style="block", frames_per_cycle=1.0, sent=100,
+                 wire={"frames_lost": 0}, wire_signals_lost=0),
+        ]
+
+    def status(self, checks, prefix):
+        return next(c["status"] for c in checks if c["text"].startswith(prefix))
+
+    def test_targets(self):
+        meta = {"date": "d", "command": "scripts/bench", "loadavg_start": ["1", "1", "1"]}
+        text, checks = report.render(self.rows(12000, 10000), meta, [], "/tmp", [])
+        self.assertEqual(self.status(checks, "board->board raw one-way, 8 B"), "met")
+        self.assertEqual(self.status(checks, "setup-simulation event"), "met")
+        self.assertEqual(self.status(checks, "10 kHz: no frame"), "met")
+        self.assertIn("1.20x", text)
+        text, checks = report.render(self.rows(14000, 10000), meta, [], "/tmp", [])
+        self.assertEqual(self.status(checks, "board->board raw one-way, 8 B"), "MISSED")
+        self.assertIn("over by 8%", text)
+        self.assertNotIn(REPO + os.sep, text)
+
+
+if __name__ == "__main__":
+    unittest.main()

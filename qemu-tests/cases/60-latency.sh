@@ -1,0 +1,76 @@
+#!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
+# qemu-tests: the thesis latency tables 6.2-6.4 redone between the two boards, 100 Hz to
+# qemu-tests: 1 kHz plus 5 kHz: RTT/2 through ccomm (app -> ccommd -> wire -> ccommd ->
+# qemu-tests: app and back) next to a raw-socket floor measured between the same boards
+# qemu-tests: in the same run, with the ratio. Report: <work>/latency.md and .jsonl.
+# qemu-tests: timeout=900
+. "$(dirname "$0")/../lib/common.sh"
+need_ccomm
+
+RATES=${QT_LAT_RATES:-100 200 300 400 500 600 800 1000 5000}
+SECS=${QT_LAT_SECONDS:-3}     # measured seconds per point (the thesis: at least 10)
+PRIO=${QT_LAT_PRIO:-70}       # SCHED_FIFO of the measuring programs, below ccommd's 80
+MAX_LOSS_LOW=${QT_LAT_MAX_LOSS:-2} # % allowed at <= 200 Hz, where a period is >= 5 ms
+OUT=$QT_WORK/latency.jsonl
+: >"$OUT"
+
+# The two programs shared with the benchmarks (src/bench, src/tools), as installed.
+NF=$(vm planner 'command -v net_floor || ls /usr/libexec/ccomm/bench/net_floor 2>/dev/null' | head -n1)
+check "raw-socket floor program (net_floor) installed" test -n "$NF"
+check "ccomm latency program (ccomm-latency) installed" vm control 'command -v ccomm-latency >/dev/null'
+[ -n "$NF" ] || finish
+
+sig_cp=$(vm control 'ccomm list' | awk 'NR > 1 && $5 == "control" && $3 == "double" {print $2; exit}')
+sig_pc=$(vm planner 'ccomm list' | awk 'NR > 1 && $5 == "planner" && $3 == "double" {print $2; exit}')
+mac_p=$(board_mac planner)
+note "rates: $RATES Hz; $SECS s per point; SCHED_FIFO $PRIO; single signal: $sig_cp -> / <- $sig_pc"
+
+record() { # KIND EXPERIMENT RATE JSON-LINE
+	local j
+	j=$(grep -m1 '^{' <<<"$4")
+	if [ -z "$j" ]; then
+		echo "  $2/$1 at $3 Hz: no result: $(head -n 3 <<<"$4")"
+		j='{}'
+	fi
+	printf '{"kind":"%s","experiment":"%s","rate":%s,"result":%s}\n' "$1" "$2" "$3" "$j" >>"$OUT"
+}
+
+floor_point() { # RATE PAYLOAD EXPERIMENT
+	local r=$1 p=$2
+	vm_bg planner floor "$NF --transport raw --role echo --if eth0 --prio $PRIO" >/dev/null
+	local out
+	out=$(vm --timeout $((SECS + 60)) control "$NF --transport raw --role ping --if eth0 --dst $mac_p \
+--rate $r --count $((r * SECS)) --warmup $((r / 2)) --payload $p --half --prio $PRIO --timeout-ms 500 \
+--start-wait-ms 10000 --name floor-$3" 2>&1)
+	vm_bg_stop planner floor >/dev/null
+	record floor "$3" "$r" "$out"
+}
+
+ccomm_point() { # RATE EXPERIMENT [SEND RECV on control]
+	local r=$1 e=$2 sc=${3:-} rc=${4:-}
+	local args_c= args_p=
+	[ -n "$sc" ] && args_c="--send $sc --recv $rc" && args_p="--send $rc --recv $sc"
+	vm_bg planner echo "ccomm-latency --mode echo $args_p -r $r -d $((SECS + 30)) --prio $PRIO" >/dev/null
+	sleep 1 # the echo side attaches and waits
+	local out
+	out=$(vm --timeout $((SECS + 60)) control "ccomm-latency --mode ping $args_c -r $r -d $SECS.5 --warmup 0.5 \
+--prio $PRIO --label ccomm-$e" 2>&1)
+	vm_bg_stop planner echo >/dev/null
+	record ccomm "$e" "$r" "$out"
+}
+
+for r in $RATES; do
+	note "$r Hz ..."
+	floor_point "$r" 8 single
+	ccomm_point "$r" single "$sig_cp" "$sig_pc"
+	floor_point "$r" 288 setup
+	ccomm_point "$r" setup
+done
+
+python3 "$QT_REPO/qemu-tests/lib/latency_report.py" "$OUT" --max-loss-low "$MAX_LOSS_LOW" \
+	--markdown "$QT_WORK/latency.md"
+rc=$?
+note "report: $QT_WORK/latency.md, samples per point in $OUT"
+check "every point measured; loss <= ${MAX_LOSS_LOW}% at <= 200 Hz for ccomm and the floor" test $rc = 0
+finish

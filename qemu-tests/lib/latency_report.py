@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Latency report of qemu-tests/cases/60-latency.sh.
+
+Reads the JSON lines the case wrote (one per measured point: kind ccomm|floor,
+experiment single|setup, rate, and the program's own result line) and prints, per
+experiment, one row per rate: min/p50/p99/max and loss for ccomm and for the raw-socket
+floor measured between the same two boards in the same run, and the ratios.
+
+Exit status 1 if a point has no result, or if loss at <= 200 Hz exceeds --max-loss-low
+percent (a period of 5 ms or more leaves no excuse to lose a cycle, even emulated).
+"""
+
+import argparse
+import json
+import sys
+
+# The thesis' numbers for orientation only: real Overo boards, one way, read from an
+# oscilloscope (min-max, microseconds). Table 6.2 single signal; 6.3 setup-simulation
+# A->B (36 doubles); 6.4 B->A (9 doubles).
+THESIS = {
+    "single": {100: "900-2000", 200: "980-2100", 300: "280-2140", 400: "580-1800",
+               500: "840-2120", 600: "620-1880", 800: "840-2020", 1000: "400-1450"},
+    "setup": {100: "600-2000 / 1400-1700", 200: "900-3180 / 550-2900", 300: "960-2190 / 1100-2250",
+              400: "1120-2600 / 1000-2900", 500: "1260-2660 / 920-2100", 600: "900-2400 / 1100-2280",
+              800: "920-3360 / 950-5000"},
+}
+TITLES = {
+    "single": "Single signal (table 6.2): one double control -> planner and one back",
+    "setup": "Setup-simulation (tables 6.3/6.4): 36 doubles control -> planner, 9 back",
+}
+THESIS_HEAD = {"single": "thesis 6.2", "setup": "thesis 6.3 / 6.4"}
+
+
+def us(ns):
+    return "-" if ns is None or ns < 0 else "%.0f" % (ns / 1000.0)
+
+
+def loss_pct(kind, r):
+    if kind == "ccomm":
+        got, lost = r.get("received", 0), r.get("lost", 0)
+    else:
+        got, lost = r.get("count", 0), r.get("lost", 0)
+    total = got + lost
+    return 100.0 * lost / total if total else None
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("jsonl")
+    ap.add_argument("--max-loss-low", type=float, default=2.0)
+    ap.add_argument("--markdown")
+    a = ap.parse_args()
+
+    points = {}
+    for line in open(a.jsonl):
+        line = line.strip()
+        if line:
+            p = json.loads(line)
+            points[(p["experiment"], p["rate"], p["kind"])] = p["result"]
+
+    problems = []
+    out = ["RTT/2 in microseconds between the two emulated boards (qemu-system-arm TCG,",
+           "PREEMPT_RT guest kernels, raw Ethernet over a bridge). Emulation dominates the",
+           "absolute numbers; the ratio to the floor measured in the same run is what carries",
+           "over. loss: ccomm = cycles whose values never came back (superseded or lost);",
+           "floor = replies missing or later than 500 ms.", ""]
+    for exp in ("single", "setup"):
+        rates = sorted({r for (e, r, _) in points if e == exp})
+        if not rates:
+            continue
+        out.append("### " + TITLES[exp])
+        out.append("")
+        out.append("| Hz | ccomm min | p50 | p99 | max | loss % | floor min | p50 | p99 | max | loss % "
+                   "| p50 ratio | p99 ratio | %s |" % THESIS_HEAD[exp])
+        out.append("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+        for rate in rates:
+            cells = ["%d" % rate]
+            res = {}
+            for kind in ("ccomm", "floor"):
+                r = points.get((exp, rate, kind), {})
+                n = r.get("count", 0)
+                if not n:
+                    problems.append("%s %s at %d Hz: no samples" % (exp, kind, rate))
+                    cells += ["-"] * 5
+                    continue
+                lp = loss_pct(kind, r)
+                res[kind] = r
+                cells += [us(r.get("min_ns")), us(r.get("p50_ns")), us(r.get("p99_ns")), us(r.get("max_ns")),
+                          "-" if lp is None else "%.1f" % lp]
+                if rate <= 200 and lp is not None and lp > a.max_loss_low:
+                    problems.append("%s %s at %d Hz: %.1f%% lost (limit %.1f%%)" % (exp, kind, rate, lp, a.max_loss_low))
+            for q in ("p50_ns", "p99_ns"):
+                c, f = res.get("ccomm", {}).get(q), res.get("floor", {}).get(q)
+                cells.append("%.1f" % (c / f) if c and f and c > 0 and f > 0 else "-")
+            cells.append(THESIS[exp].get(rate, ""))
+            out.append("| " + " | ".join(cells) + " |")
+        out.append("")
+    if problems:
+        out.append("Problems: " + "; ".join(problems))
+    text = "\n".join(out)
+    print(text)
+    if a.markdown:
+        with open(a.markdown, "w") as f:
+            f.write("# ccomm latency between two emulated boards\n\n" + text + "\n")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

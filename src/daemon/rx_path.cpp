@@ -20,16 +20,16 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
     Count(store::kFramesAuthFailed);
     return;
   }
-  if (h.config_hash != cfg_->hash) {
-    Count(store::kFramesWrongHash);
-    return;
-  }
   if (h.sender >= peers_rx_.size() || h.sender == self_ || !peers_tx_[h.sender].active) {
     Count(store::kFramesUnknownSender);
     return;
   }
   if (h.dest != self_ && h.dest != wire::kDestAll) {
     Count(store::kFramesNotForUs);  // a broadcast frame meant for another node
+    return;
+  }
+  if (h.config_hash != cfg_->hash) {
+    Count(store::kFramesWrongHash);
     return;
   }
   if (auth_.enabled() &&
@@ -131,9 +131,10 @@ void Daemon::RunRx() {
     if (n > 0) {
       HandleFrame(rx_buf_, static_cast<size_t>(n), platform::MonotonicNs());
     } else if (n < 0) {
-      if (n == -EMSGSIZE) Count(store::kFramesBad);
+      const bool bad_frame = n == -EMSGSIZE || n == -ENODATA;  // oversized or empty: junk, not a fault
+      if (bad_frame) Count(store::kFramesBad);
       else Count(store::kRecvErrors);
-      if (n != -EMSGSIZE) {
+      if (!bad_frame) {
         // e.g. ENETDOWN while the link is down: do not spin.
         struct timespec ts = {0, 10 * 1000 * 1000};
         nanosleep(&ts, nullptr);

@@ -28,7 +28,8 @@ struct TransportOps {
   /// Sends one frame; 0 or -errno. Never blocks for long (socket send buffer).
   int (*send)(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len);
   /// Waits up to the transport's receive timeout for one frame. Returns its length,
-  /// 0 on timeout, or -errno. `from` is filled when a frame is returned.
+  /// 0 on timeout, -EMSGSIZE for a frame larger than `cap`, -ENODATA for an empty one,
+  /// or another -errno. `from` is filled when a frame is returned.
   ssize_t (*recv)(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from);
   void (*close)(Transport* t);
 };

@@ -37,6 +37,7 @@ ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
     if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -errno;
     if (sll.sll_pkttype == PACKET_OUTGOING) continue;  // our own frames, looped back
     if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
+    if (n == 0) return -ENODATA;  // an empty frame; 0 means "timeout" to the caller
     memcpy(from->mac, sll.sll_addr, 6);
     // Ethernet pads payloads to 46 bytes: drop (zero) padding after the declared frame.
     n = static_cast<ssize_t>(wire::TrimEthernetPadding(buf, static_cast<size_t>(n)));

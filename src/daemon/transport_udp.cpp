@@ -29,6 +29,7 @@ ssize_t UdpRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
   ssize_t n = recvfrom(t->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sin), &sl);
   if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -errno;
   if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
+  if (n == 0) return -ENODATA;  // an empty datagram; 0 means "timeout" to the caller
   from->ipv4 = sin.sin_addr.s_addr;
   from->port = sin.sin_port;
   return n;

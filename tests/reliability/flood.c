@@ -3,8 +3,9 @@
  * flood: sends junk at ccommd -- random bytes, truncated frames and broken headers --
  * over raw Ethernet (AF_PACKET, ccommd's EtherType) or UDP (its port), batched with
  * sendmmsg, paced to a rate. Every frame it sends is one ccommd must count as
- * frames_bad (none can decode: the magic is wrong, or the frame is shorter than it
- * declares, or a reserved field is set), so a test can compare counts exactly.
+ * frames_bad (none can decode: the magic is wrong, the frame is shorter than it
+ * declares, a reserved field is set, or it is empty), so a test can compare counts
+ * exactly.
  *
  * It can also replay: capture N frames ccommd sends on an interface and send them again
  * (the authentication test uses this to check that replays are refused).
@@ -43,7 +44,7 @@ static const char usage[] =
     "  --src MAC          source MAC written into the frames (default: IF's own)\n"
     "  --udp IP           UDP to IP instead\n"
     "  --port N           UDP port (default 47800)\n"
-    "  --kind K           random | truncated | badhdr | mixed (default mixed)\n"
+    "  --kind K           random | truncated | badhdr | empty | mixed (default mixed)\n"
     "  --rate N           frames per second, 0 = as fast as possible (default 0)\n"
     "  --duration S       stop after S seconds (default 5)\n"
     "  --count N          stop after N frames\n"
@@ -94,11 +95,13 @@ static void plausible_header(uint8_t* f, uint16_t payload) {
   put16(f + 30, 0);
 }
 
-/* Fills f with one junk frame of kind k (0 random, 1 truncated, 2 bad header); returns
- * its length (>= 1: a zero-length datagram is indistinguishable from a receive timeout). */
+/* Fills f with one junk frame of kind k (0 random, 1 truncated, 2 bad header, 3 empty);
+ * returns its length. */
 static size_t make_junk(uint8_t* f, int k) {
   size_t len;
   switch (k) {
+    case 3: /* nothing at all after the Ethernet header / an empty datagram */
+      return 0;
     case 0: /* random bytes; first byte never 'C' so the magic can never match */
       len = 1 + rnd() % MAX_FRAME;
       for (size_t i = 0; i < len; ++i) f[i] = (uint8_t)rnd();
@@ -159,11 +162,17 @@ int main(int argc, char** argv) {
     fputs(usage, stderr);
     return 2;
   }
-  int kinds[3], nkinds = 0;
+  int kinds[4], nkinds = 0;
   if (!strcmp(kind, "random")) kinds[nkinds++] = 0;
   else if (!strcmp(kind, "truncated")) kinds[nkinds++] = 1;
   else if (!strcmp(kind, "badhdr")) kinds[nkinds++] = 2;
-  else if (!strcmp(kind, "mixed")) { kinds[0] = 0; kinds[1] = 1; kinds[2] = 2; nkinds = 3; }
+  else if (!strcmp(kind, "empty")) kinds[nkinds++] = 3;
+  else if (!strcmp(kind, "mixed")) {
+    /* Empty raw frames never reach a SOCK_DGRAM packet socket (the kernel drops them
+     * uncounted), so the raw mix leaves them out to keep counts comparable. */
+    kinds[0] = 0; kinds[1] = 1; kinds[2] = 2; kinds[3] = 3;
+    nkinds = ifname ? 3 : 4;
+  }
   else { fprintf(stderr, "flood: unknown kind %s\n", kind); return 2; }
 
   /* Frames are pre-built into a pool (Ethernet header included for raw), so sending is

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Junk flood: tests/reliability/flood.c sends random, truncated and broken-header frames
-# at the planner's ccommd (raw EtherType, then UDP port), paced and then as fast as it
+# (and empty datagrams over UDP) at the planner's ccommd (raw EtherType, then UDP port), paced and then as fast as it
 # can, while control pings the planner through ccomm and a local app on the planner
 # writes and reads its own signal. Checks, per phase:
 #   - every frame that reached the planner's eth0 is accounted for exactly:

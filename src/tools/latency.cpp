@@ -47,13 +47,16 @@ const char kUsage[] =
     "      --cpu N            pin the receive thread to CPU N\n"
     "      --label TEXT       name in the JSON result\n"
     "      --samples FILE     write every latency sample (ns) to FILE\n"
+    "      --stages FILE      oneway: write each sample as 'total<TAB>last hop' (ns), the last hop\n"
+    "                         being the time since ccommd stored the newest value of the cycle\n"
+    "                         on this node (so total - last hop = producer write -> ccommd here)\n"
     "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
     "p999_ns,max_ns,mean_ns,count}.\n";
 
 struct Options {
   const char* node = nullptr;
   double rate = 1000, duration = 10, warmup = 0.5;
-  std::string mode = "oneway", label = "ccomm", samples_file;
+  std::string mode = "oneway", label = "ccomm", samples_file, stages_file;
   std::string send, recv;
   int prio = 0, rx_prio = -1;
   bool spin = false;
@@ -88,10 +91,10 @@ struct Shared {
   std::vector<uint64_t> send_time;  // [k % kHistory]
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> sent{0};
-  bool ping = false, echo = false, spin = false;
+  bool ping = false, echo = false, spin = false, stages = false;
   int cpu = -1, prio = 0;
   uint64_t warmup_until = 0;
-  std::vector<int64_t> samples;
+  std::vector<int64_t> samples, last_hop;
   uint64_t first_k = 0, last_k = 0, received = 0;
   bool any = false;
 };
@@ -107,6 +110,7 @@ void* Receiver(void* arg) {
   std::vector<uint64_t> last_seq(n, 0);
   std::vector<double> got(n, -1);
   std::vector<uint64_t> src(n, 0);
+  std::vector<uint64_t> stored(n, 0);  // when ccommd stored the value here (estimate)
   double last_complete = -1;
   std::vector<bool> is_event(n, false);
   for (size_t i = 0; i < n; ++i) {
@@ -139,6 +143,10 @@ void* Receiver(void* arg) {
     for (size_t i = 0; i < n; ++i) {
       double v;
       ccomm_info info;
+      // ccomm_read takes its clock reading for age_ns on entry: age measured from
+      // just before the call gives the store time even if the call was preempted by
+      // the very ccommd thread that stored the value.
+      const uint64_t t_read = s->stages ? Now() : 0;
       int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
       // Events queue: take every one waiting, keep the newest (one wake-up may find
       // several, and leaving them queued would delay every later sample).
@@ -146,6 +154,7 @@ void* Receiver(void* arg) {
         last_seq[i] = info.seq;
         got[i] = v;
         src[i] = info.source_time_ns;
+        stored[i] = t_read - static_cast<uint64_t>(info.age_ns);
         changed = true;
         if (!is_event[i]) break;
         r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
@@ -156,9 +165,11 @@ void* Receiver(void* arg) {
     double k = got[0];
     bool complete = k > last_complete;
     uint64_t latest_src = 0;
+    uint64_t newest_store = 0;
     for (size_t i = 0; i < n && complete; ++i) {
       complete = got[i] == k;
       latest_src = std::max(latest_src, src[i]);
+      newest_store = std::max(newest_store, stored[i]);
     }
     if (!complete) continue;
     last_complete = k;
@@ -180,7 +191,10 @@ void* Receiver(void* arg) {
     s->any = true;
     s->last_k = kk;
     s->received++;
-    if (s->samples.size() < s->samples.capacity()) s->samples.push_back(lat);
+    if (s->samples.size() < s->samples.capacity()) {
+      s->samples.push_back(lat);
+      s->last_hop.push_back(static_cast<int64_t>(now - newest_store));
+    }
   }
   return nullptr;
 }
@@ -220,6 +234,7 @@ int main(int argc, char** argv) {
       {"warmup", required_argument, nullptr, 'W'}, {"prio", required_argument, nullptr, 'P'},
       {"rx-prio", required_argument, nullptr, 'Q'},
       {"label", required_argument, nullptr, 'L'},  {"samples", required_argument, nullptr, 'F'},
+      {"stages", required_argument, nullptr, 'G'},
       {"spin", no_argument, nullptr, 'X'},         {"cpu", required_argument, nullptr, 'C'},
       {"help", no_argument, nullptr, 'h'},         {nullptr, 0, nullptr, 0}};
   int ch;
@@ -236,6 +251,7 @@ int main(int argc, char** argv) {
       case 'Q': o.rx_prio = atoi(optarg); break;
       case 'L': o.label = optarg; break;
       case 'F': o.samples_file = optarg; break;
+      case 'G': o.stages_file = optarg; break;
       case 'X': o.spin = true; break;
       case 'C': o.cpu = atoi(optarg); break;
       case 'h': fputs(kUsage, stdout); return 0;
@@ -260,8 +276,10 @@ int main(int argc, char** argv) {
   s.spin = o.spin;
   s.cpu = o.cpu;
   s.prio = o.rx_prio >= 0 ? o.rx_prio : o.prio;
+  s.stages = !o.stages_file.empty();
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
+  s.last_hop.reserve(s.samples.capacity());
   mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort
 
   uint64_t start = Now();
@@ -308,6 +326,13 @@ int main(int argc, char** argv) {
   if (!o.samples_file.empty()) {
     if (FILE* f = fopen(o.samples_file.c_str(), "w")) {
       for (int64_t x : s.samples) fprintf(f, "%" PRId64 "\n", x);
+      fclose(f);
+    }
+  }
+  if (!o.stages_file.empty()) {
+    if (FILE* f = fopen(o.stages_file.c_str(), "w")) {
+      for (size_t i = 0; i < s.samples.size(); ++i)
+        fprintf(f, "%" PRId64 "\t%" PRId64 "\n", s.samples[i], s.last_hop[i]);
       fclose(f);
     }
   }

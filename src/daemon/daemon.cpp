@@ -125,9 +125,12 @@ void Daemon::Supervise(uint64_t now) {
   for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
     if (!peers_tx_[p].active) continue;
     store::PeerStats& ps = segment_.peer(p);
+    // alive before last: the receive thread stores last, then sets alive (release), so a
+    // peer seen alive here comes with its newest last. `now` was read before `last`: a
+    // frame that arrived since (last > now) is no silence.
+    bool alive = ps.alive.load(std::memory_order_acquire) != 0;
     uint64_t last = ps.last_rx_ns.load(std::memory_order_acquire);
-    bool alive = ps.alive.load(std::memory_order_relaxed) != 0;
-    if (alive && now - last > peer_timeout_ns_) {
+    if (alive && now > last && now - last > peer_timeout_ns_) {
       ps.alive.store(0, std::memory_order_release);
       ps.down_transitions.fetch_add(1, std::memory_order_relaxed);
       Log(LogLevel::kWarning, "peer '%s' lost: nothing received for %u ms", cfg_->nodes[p].name.c_str(),
@@ -138,7 +141,7 @@ void Daemon::Supervise(uint64_t now) {
     const SignalConfig& s = cfg_->signals[id];
     if (!s.stale_after_ms) continue;
     uint64_t last = segment_.stats(id).last_rx_ns.load(std::memory_order_relaxed);
-    bool fresh = last && now - last <= uint64_t{s.stale_after_ms} * 1000000;
+    bool fresh = last && (last >= now || now - last <= uint64_t{s.stale_after_ms} * 1000000);
     if (fresh_[id] && !fresh) segment_.stats(id).stale_transitions.fetch_add(1, std::memory_order_relaxed);
     fresh_[id] = fresh;
   }

@@ -66,6 +66,7 @@ class Daemon {
     bool seen = false;
     uint32_t expected = 0;
     uint64_t last_send_ns = 0;  // newest send time seen: a lower seq sent later = restart
+    uint64_t last_rx_ns = 0;    // our clock at its last accepted frame (receive thread only)
   };
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);

@@ -48,7 +48,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   } else if (ahead < 0x80000000u) {
     ps.frames_lost.fetch_add(ahead, std::memory_order_relaxed);
     pr.expected = h.seq + 1;
-  } else if (h.send_time_ns > pr.last_send_ns || !ps.alive.load(std::memory_order_relaxed)) {
+  } else if (h.send_time_ns > pr.last_send_ns || now - pr.last_rx_ns > peer_timeout_ns_) {
     // A lower seq sent later than anything seen (or after silence): the peer restarted.
     // Its value sequence numbers may restart too.
     Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)",
@@ -60,6 +60,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
     ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
   }
   if (h.send_time_ns > pr.last_send_ns) pr.last_send_ns = h.send_time_ns;
+  pr.last_rx_ns = now;
   ps.frames_rx.fetch_add(1, std::memory_order_relaxed);
   ps.last_seq.store(h.seq, std::memory_order_relaxed);
   ps.last_rx_ns.store(now, std::memory_order_release);

@@ -67,3 +67,32 @@ def test_wrong_config_hash_is_rejected_and_counted(tmp_path):
         st = pair.stats("planner")
         assert st["counters"]["frames_wrong_hash"] > 0
         assert signal_stats(st, "wheel0_pos")["rx"] == 0
+
+
+def test_periodic_mode_batches_due_signals_into_one_frame(tmp_path):
+    """rate_hz on every control->planner signal: ccommd sends all of them together, once
+    per period, even when the app wrote only once (the last value keeps flowing)."""
+    import time
+    from harness import DEFAULT_CONFIG
+    cfg = tmp_path / "periodic.xml"
+    text = open(DEFAULT_CONFIG).read().replace('producer="control" consumers="planner" stale_after_ms="20"',
+                                               'producer="control" consumers="planner" stale_after_ms="50" rate_hz="200"')
+    cfg.write_text(text)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        pair.start("planner")
+        pair.cli("control", "pub", "wheel2_cur", "4.5")  # one write, then nothing
+        t0 = time.time()
+        before = peer_stats(pair.stats("control"), "planner")["frames_tx"]
+        rx_before = signal_stats(pair.stats("planner"), "wheel2_cur")["rx"]
+        time.sleep(1.0)
+        frames = peer_stats(pair.stats("control"), "planner")["frames_tx"] - before
+        rx = signal_stats(pair.stats("planner"), "wheel2_cur")["rx"] - rx_before
+        elapsed = time.time() - t0  # each stats call itself takes ~0.2 s
+        # ~200 frames/s, each carrying the value; never more than one frame per period.
+        assert 150 <= frames <= 200 * elapsed + 5, (frames, elapsed)
+        assert abs(rx - frames) <= 5, (rx, frames)
+        assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh")
+        # Signals never written are not sent: only wheel2_cur has a value.
+        st = pair.stats("planner")
+        assert signal_stats(st, "wheel0_pos")["rx"] == 0

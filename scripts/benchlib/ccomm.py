@@ -15,6 +15,7 @@ line and its raw samples), counters from `ccomm stats --json`, CPU time from
 import glob
 import json
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -270,9 +271,11 @@ class Daemons:
 # ccomm-latency
 
 def latency_argv(bins, node, rate, duration, prio, label, samples, mode="oneway", send=None, recv=None,
-                 spin=False, rx_cpu=None, warmup=0.5, rx_prio=None):
+                 spin=False, rx_cpu=None, warmup=0.5, rx_prio=None, stages=False):
     argv = [bins["ccomm-latency"], "--node", node, "--rate", "%g" % rate, "--duration", "%g" % duration,
             "--warmup", "%g" % warmup, "--mode", mode, "--label", label, "--samples", samples]
+    if stages and mode == "oneway":
+        argv += ["--stages", samples + ".stages"]
     if prio:
         argv += ["--prio", str(prio)]
     if rx_prio is not None:
@@ -359,11 +362,38 @@ def samples_row(name, transport, payload, rate, res, samples_path, rawdir, **ext
     with open(os.path.join(rawdir, name + ".tsv"), "w") as f:
         for i, ns in enumerate(v):
             f.write("%d\t%d\n" % (i, ns))
+    st = stages(samples_path + ".stages")
+    if st:
+        extra.setdefault("stages", st)
+        rel = os.path.join("raw", name + ".stages.tsv")
+        shutil.copyfile(samples_path + ".stages", os.path.join(os.path.dirname(rawdir), rel))
+        extra.setdefault("stages_raw", rel)
     extra.setdefault("metric", "one_way")
     extra.setdefault("sent", res.get("sent"))
     row = results.row_from_samples(name, transport, payload, rate, v, res.get("lost", 0), raw=raw_rel,
                                    program="ccomm-latency", **extra)
     return row
+
+
+def stages(path):
+    """Where a one-way sample's time went, from ccomm-latency --stages: "upstream" =
+    producer's write -> the receiving ccommd has the frame (doorbell, sending ccommd,
+    kernel, wire), "last_hop" = the receiving ccommd stored it -> the application saw
+    it. Percentiles of each part on its own."""
+    try:
+        with open(path) as f:
+            pairs = [tuple(int(x) for x in line.split()) for line in f if len(line.split()) == 2]
+    except (OSError, ValueError):
+        return None
+    if not pairs:
+        return None
+    up = sorted(t - h for t, h in pairs)
+    hop = sorted(h for _, h in pairs)
+    out = {}
+    for key, v in (("upstream", up), ("last_hop", hop)):
+        for q, tag in ((0.5, "p50"), (0.99, "p99")):
+            out["%s_%s_ns" % (key, tag)] = results.percentile(v, q)
+    return out
 
 
 def delta_stats(before, after, src, dst):

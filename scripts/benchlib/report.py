@@ -4,6 +4,8 @@ run's rows and meta; the prose only says how to read them."""
 
 import os
 
+from . import results
+
 # The thesis' measured min/max one-way latency in µs (section 6.3): rate, min, max.
 THESIS = {
     "6.2": [(100, 900, 2000), (200, 980, 2100), (300, 280, 2140), (400, 580, 1800), (500, 840, 2120),
@@ -180,11 +182,17 @@ def checks(R, meta):
     # 4. 10 kHz without loss: nothing lost by ccomm, and every cycle seen by the application.
     rows = [r for r in R.where(section="thesis") if r["rate_hz"] == 10000 and _style(r) == "block"]
     if rows:
-        wire = [r for r in rows if r.get("wire_signals_lost") or (r.get("wire") or {}).get("frames_lost")]
-        detail = "; ".join("`%s`: %d frames / %d values lost" % (
-            r["name"], (r.get("wire") or {}).get("frames_lost", 0), r.get("wire_signals_lost", 0)) for r in rows)
-        out.append(_check("10 kHz: no frame or value lost by ccomm (every experiment and mode)", not wire, detail,
-                          "loss"))
+        for mode in ("event", "periodic"):
+            mrows = [r for r in rows if r.get("mode") == mode]
+            if not mrows:
+                continue
+            wire = [r for r in mrows if r.get("wire_signals_lost") or (r.get("wire") or {}).get("frames_lost")]
+            detail = "; ".join("`%s`: %d frames / %d values lost" % (
+                r["name"], (r.get("wire") or {}).get("frames_lost", 0), r.get("wire_signals_lost", 0))
+                for r in mrows)
+            out.append(_check("10 kHz, %s: no frame or value lost by ccomm" % (
+                "event-driven" if mode == "event" else "periodic"), not wire, detail,
+                "periodic" if mode == "periodic" else "loss"))
         app = [r for r in rows if r["lost"]]
         detail = "; ".join("`%s`: %d of %s cycles missed" % (r["name"], r["lost"], r.get("sent")) for r in rows)
         out.append(_check("10 kHz: the receiving application saw every cycle (blocking receive)", not app, detail,
@@ -278,6 +286,11 @@ def _cost_tables(R, meta):
     cost = meta.get("cost") or {}
     out = []
     rows = [r for r in R.where(section="thesis") if r.get("cpu") and r.get("forwarded")]
+    idle = cost.get("idle")
+    # Idle CPU per second of both daemons together (schedstat), to subtract the fixed part.
+    idle_ms_per_s = None
+    if idle and idle.get("wall_s"):
+        idle_ms_per_s = sum(v["cpu_ms_sched"] for k, v in idle.items() if k != "wall_s") / idle["wall_s"]
     seen = set()
     lines = []
     for r in sorted(rows, key=lambda r: (r["exp"], r["mode"], r["rate_hz"])):
@@ -296,6 +309,8 @@ def _cost_tables(R, meta):
                       "%.0f (%.0f + %.0f)" % (ticks_ms, user_ms, sys_ms), "%.1f" % sched_ms,
                       "**%.2f**" % (ticks_ms / fw * 1000) if fw else "-",
                       "%.2f" % (sched_ms / fw * 1000) if fw else "-",
+                      "%.2f" % ((sched_ms - idle_ms_per_s * cpu["wall_s"]) / fw * 1000)
+                      if fw and idle_ms_per_s is not None else "-",
                       "%.1f" % (100.0 * sched_ms / 1000.0 / cpu["wall_s"] / max(1, len(nodes)))])
     if lines:
         out.append("CPU time of both ccommd processes over a thesis run (board A and board B together), "
@@ -304,9 +319,16 @@ def _cost_tables(R, meta):
                    "the scheduler's run time from /proc/PID/task/*/schedstat, in ns):\n" % meta.get("clk_tck", 100))
         out.append(_table(["experiment / mode", "Hz", "forwarded", "wall s", "CPU ms, stat (user + system)",
                            "CPU ms (schedstat)",
-                           "ms / 1000 signals (stat)", "ms / 1000 signals (schedstat)", "% of a CPU per daemon"],
+                           "ms / 1000 signals (stat)", "ms / 1000 signals (schedstat)",
+                           "ms / 1000 signals, idle subtracted", "% of a CPU per daemon"],
                           lines))
         out.append("")
+        out.append("Reading it: most of ccommd's CPU time is system time (the `sendto`/`recvfrom` calls into the "
+                   "veth path, futex wake-ups), and it is paid per frame, so batching many signals into one "
+                   "frame (setup-simulation) costs far less per signal than one signal per frame; at low rates "
+                   "the fixed part (heartbeats, the 10 ms supervision tick, see idle below) dominates. The "
+                   "\"idle subtracted\" column removes the idle CPU rate measured below. Periodic mode costs "
+                   "about twice event-driven mode because every cycle is sent twice (see Targets).\n")
     idle = cost.get("idle")
     if idle:
         nodes = [k for k in idle if k != "wall_s"]
@@ -367,14 +389,23 @@ def _why(R, meta, check):
              "two extra hand-offs are context switches on a CPU, not cross-CPU wake-ups. Measured in this run:"]
         t.append("- ccomm (blocking application) p50 %s µs - floor p50 %s µs = **%s µs** added by ccomm." % (
             us(c["p50_ns"]), us(f["p50_ns"]), us(c["p50_ns"] - f["p50_ns"])))
+        g = c.get("stages")
+        if g:
+            t.append("- Split at the receiving ccommd (`--stages`): application write -> ccommd on board B has "
+                     "the frame p50 %s µs (the floor's whole socket-to-socket path: %s µs, so board A's doorbell "
+                     "wake-up of ccommd's send thread and both daemons' work add about %s µs), then ccommd -> "
+                     "application on board B p50 %s µs (a futex wake-up on the same CPU plus reading the values)."
+                     % (us(g["upstream_p50_ns"]), us(f["p50_ns"]), us(g["upstream_p50_ns"] - f["p50_ns"]),
+                        us(g["last_hop_p50_ns"])))
         if s:
             line = ("- The same with the receiving application busy-polling (`%s`, no wake-up of the "
                     "application; ccommd still blocks in `recv` like the floor): p50 %s µs, %.2fx the floor" % (
                         s["name"], us(s["p50_ns"]), s["p50_ns"] / float(f["p50_ns"])))
-            if s["p50_ns"] <= c["p50_ns"]:
-                line += ("; so the application's wake-up on board B accounts for about %s µs of the %s µs"
+            if f["p50_ns"] < s["p50_ns"] < c["p50_ns"]:
+                line += ("; the application's wake-up on board B accounts for about %s of the %s µs"
                          % (us(c["p50_ns"] - s["p50_ns"]), us(c["p50_ns"] - f["p50_ns"])))
-            t.append(line + ".")
+            t.append(line + ". On a one-CPU board a polling application still waits for ccommd's receive "
+                     "thread (higher priority, same CPU) to finish and block in `recv` again.")
         if fx:
             t.append("- For scale: one futex wake-up between two CPUs on this machine (`shm_futex_1khz_p8`, "
                      "RTT/2) is %s µs at p50." % us(fx["p50_ns"]))
@@ -429,11 +460,41 @@ def _why(R, meta, check):
                 "rings the doorbell for periodic-only writes), reported to the lead rather than changed here."
                 % (ex or "see the table"))
     if check["why"] == "loss":
+        rows = [r for r in R.where(section="thesis", mode="event") if r["rate_hz"] == 10000 and r.get("cpu")]
+        extra = ""
+        if rows:
+            r = rows[0]
+            nodes = [k for k in r["cpu"] if k != "wall_s"]
+            pct = ["%s %.0f%% (%.0f%% in the kernel)" % (
+                n, 100.0 * r["cpu"][n]["cpu_ms_sched"] / 1000.0 / r["cpu"]["wall_s"],
+                100.0 * r["cpu"][n].get("system_ms", 0) / 1000.0 / r["cpu"]["wall_s"]) for n in nodes]
+            above = _frac_above(r, 100000)
+            extra = (" In `%s` the receiving application's one-way p50 is %s µs and %s of its samples exceed "
+                     "the 100 µs period; each board's single CPU is also busy with its ccommd (%s of a CPU: "
+                     "the sends and receives are system calls into the veth path)." % (
+                         r["name"], us(r["p50_ns"]), above, ", ".join(pct)))
         return ("At 10 kHz a cycle is 100 µs; \"app missed\" counts cycles whose values the receiving "
                 "application never saw because the next cycle's values overwrote them first (state signals "
                 "keep the last value) - a late wake-up of the receiver, not a lost frame; \"wire lost\" "
-                "counts frames missing in ccommd's sequence numbers and values ccommd knows were lost.")
+                "counts frames missing in ccommd's sequence numbers and values ccommd knows were lost." + extra)
     return ""
+
+
+def _frac_above(r, ns):
+    """Share of a row's raw samples above ns, as text."""
+    raw = r.get("raw")
+    if not raw or not _OUTDIR[0]:
+        return "some"
+    path = os.path.join(_OUTDIR[0], raw)
+    if not os.path.exists(path):
+        return "some"
+    v = [x for _, x in results.load_raw(path) if x >= 0]
+    if not v:
+        return "some"
+    return "%.1f%%" % (100.0 * sum(1 for x in v if x > ns) / len(v))
+
+
+_OUTDIR = [None]
 
 
 def _machine(meta):
@@ -522,7 +583,8 @@ node names, addresses and CPUs as parameters.
 """
 
 
-def render(rows, meta, problems, doc_dir, pngs):
+def render(rows, meta, problems, doc_dir, pngs, outdir=None):
+    _OUTDIR[0] = outdir
     R = Rows(rows)
     cks = checks(R, meta)
     smoke = meta.get("smoke")
@@ -615,6 +677,23 @@ def render(rows, meta, problems, doc_dir, pngs):
         sec.sort(key=lambda r: (r.get("metric", ""), r["payload_bytes"], r["name"]))
         L.append(_latency_table(sec, bref, "p50 / floor"))
         L.append("")
+        st = [r for r in sec if r.get("stages") and r["name"].startswith("ccomm_")]
+        if st:
+            L.append("Where the one-way time goes (`ccomm-latency --stages`: each sample split at the moment "
+                     "the receiving ccommd took the frame from the socket; p50 of each part on its own, so the "
+                     "parts need not add up exactly):\n")
+            lines = []
+            for r in st:
+                f = R.get("net_%s_oneway_1khz_p%d" % (r["transport"], r["payload_bytes"]))
+                g = r["stages"]
+                lines.append(["`%s`" % r["name"], _style(r), "**%s**" % us(r["p50_ns"]),
+                              us(g["upstream_p50_ns"]), us(f["p50_ns"]) if f else "-",
+                              _fmt_ratio(g["upstream_p50_ns"] / float(f["p50_ns"])) if f and f["p50_ns"] else "-",
+                              us(g["last_hop_p50_ns"]), us(g["upstream_p99_ns"]), us(g["last_hop_p99_ns"])])
+            L.append(_table(["case", "receive", "total p50 µs", "app write -> far ccommd has the frame, p50",
+                             "floor one-way p50 (socket -> socket)", "ratio", "far ccommd -> app, p50",
+                             "upstream p99 †", "last hop p99 †"], lines, ["l", "l"] + ["r"] * 7))
+            L.append("")
         fr = [r for r in sec if r.get("frames_per_cycle") is not None]
         if fr:
             L.append("Frames per cycle on the wire (data frames received by the far ccommd / cycles sent): " +
@@ -634,6 +713,22 @@ def render(rows, meta, problems, doc_dir, pngs):
                  "shape (how latency grows with the rate), not absolute values.\n")
         L.append(_thesis_tables(R))
         L.append(_spin_table(R))
+        fs = []
+        for name, label in (("thesis_single_event_1khz", "single signal"),
+                            ("thesis_setup_event_1khz_a2b", "setup A->B (36 doubles)"),
+                            ("thesis_setup_event_1khz_b2a", "setup B->A (9 doubles)")):
+            r = R.get(name)
+            if r and r.get("bytes_per_frame"):
+                b = r["bytes_per_frame"]
+                fs.append("%s %.0f B (%.1f µs at 100 Mbit)" % (label, b, (max(b, 60) + 24) * 8 / 100.0))
+        if fs:
+            L.append("Frame sizes on eth0 (Ethernet header included), with the time such a frame takes on a "
+                     "100 Mbit wire like the thesis' boards (plus preamble, FCS and gap): " + ", ".join(fs) +
+                     ". Each value travels as a self-describing entry (signal id, type, count, value sequence "
+                     "number, source time; docs/protocol.md), so a double costs 32 B on the wire (24 B entry header + "
+                     "8 B value); "
+                     "on 100 Mbit the setup-simulation frame alone takes as long as the whole path measured "
+                     "here.\n")
 
     L.append("## 4. Cost\n")
     L.append(_cost_tables(R, meta) or "(not measured in this run)\n")

@@ -198,6 +198,14 @@ def merge_repeats(rows, outdir):
             first["wire"] = w
             if first.get("sent"):
                 first["frames_per_cycle"] = round(w.get("data_frames", 0) / float(first["sent"]), 3)
+        if all(r.get("stages_raw") for r in parts):
+            rel = os.path.join("raw", x + ".stages.tsv")
+            with open(os.path.join(outdir, rel), "w") as f:
+                for r in parts:
+                    with open(os.path.join(outdir, r["stages_raw"])) as g:
+                        f.write(g.read())
+            first["stages_raw"] = rel
+            first["stages"] = ccomm.stages(os.path.join(outdir, rel))
         first["seconds"] = round(sum(r.get("seconds", 0) for r in parts), 2)
         first["merged_from"] = [r["name"] for r in parts]
         out.append(results.row_from_samples(x, parts[0]["transport"], parts[0]["payload_bytes"],
@@ -323,7 +331,7 @@ def _rx_prio(ctx):
 def _app(ctx, d, side, node, rate, duration, label, samples, mode="oneway", spin=False, warmup=0.5):
     cpu = ctx.cpu(side)
     argv = ccomm.latency_argv(ctx.bins, node, rate, duration, ctx.prio, label, samples, mode=mode, spin=spin,
-                              warmup=warmup, rx_prio=_rx_prio(ctx) if spin else None)
+                              warmup=warmup, rx_prio=_rx_prio(ctx) if spin else None, stages=True)
     return d.wrap(side, ccomm.placed(argv, ctx.prio, [cpu] if cpu is not None else None))
 
 
@@ -434,9 +442,10 @@ def run_thesis(ctx, case):
                      0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name + "-src", sa, warmup=warm), lead)]
         probe = LinkProbe(ns)
-        # Two marks inside the steady part of the run (after the warm-up, before the end).
+        # Two marks inside the steady part of the run (after the warm-up, before the end);
+        # not with spinning receivers: they starve `ip` (SCHED_OTHER) on both CPUs.
         first = lead if exp == "single" else 0.0
-        probes = [(first + warm + 0.05, probe.mark), (first + dur - 0.1, probe.mark)]
+        probes = [] if spin else [(first + warm + 0.05, probe.mark), (first + dur - 0.1, probe.mark)]
         res = ccomm.run_apps(d, apps, dur + 30, probes)
         cpu = meter.stop()
         after = _snapshot(d, names)

@@ -213,6 +213,7 @@ static int cmd_stale(const char* node, const char* name, double timeout) {
   uint8_t buf[8192];
   const uint64_t end = now_ns() + (uint64_t)(timeout * 1e9);
   uint64_t fresh_reads = 0, last_arrival = 0;
+  int64_t max_fresh_age = 0;
   while (!g_stop && now_ns() < end) {
     ccomm_info info;
     r = ccomm_read(c, s, buf, d.value_bytes, &info);
@@ -220,12 +221,15 @@ static int cmd_stale(const char* node, const char* name, double timeout) {
     if (r == CCOMM_FRESH) {
       fresh_reads++;
       last_arrival = t - (uint64_t)info.age_ns;
+      if (info.age_ns > max_fresh_age) max_fresh_age = info.age_ns;
     } else if (r == CCOMM_STALE && fresh_reads > 0) {
-      /* The read that first says stale, measured from the arrival of the last value. */
-      printf("{\"stale\":\"%s\",\"stale_after_ms\":%u,\"detected_after_ms\":%.3f,\"safe_value\":%s,"
-             "\"fresh_reads\":%" PRIu64 "}\n",
-             name, d.stale_after_ms, (double)(t - last_arrival) / 1e6,
-             (info.flags & CCOMM_INFO_SAFE_VALUE) ? "true" : "false", fresh_reads);
+      /* The read that first says stale: the ages the API reported (exact: no read may say
+       * fresh beyond stale_after_ms) and the wall time since the last value arrived
+       * (includes this reader's polling and scheduling). */
+      printf("{\"stale\":\"%s\",\"stale_after_ms\":%u,\"detected_after_ms\":%.3f,\"max_fresh_age_ms\":%.3f,"
+             "\"first_stale_age_ms\":%.3f,\"safe_value\":%s,\"fresh_reads\":%" PRIu64 "}\n",
+             name, d.stale_after_ms, (double)(t - last_arrival) / 1e6, (double)max_fresh_age / 1e6,
+             (double)info.age_ns / 1e6, (info.flags & CCOMM_INFO_SAFE_VALUE) ? "true" : "false", fresh_reads);
       ccomm_close(c);
       return 0;
     }

@@ -114,7 +114,7 @@ class ReportTest(unittest.TestCase):
         text, checks = report.render(self.rows(12000, 10000), meta, [], "/tmp", [])
         self.assertEqual(self.status(checks, "board->board raw one-way, 8 B"), "met")
         self.assertEqual(self.status(checks, "setup-simulation event"), "met")
-        self.assertEqual(self.status(checks, "10 kHz: no frame"), "met")
+        self.assertEqual(self.status(checks, "10 kHz, event-driven: no frame"), "met")
         self.assertIn("1.20x", text)
         text, checks = report.render(self.rows(14000, 10000), meta, [], "/tmp", [])
         self.assertEqual(self.status(checks, "board->board raw one-way, 8 B"), "MISSED")

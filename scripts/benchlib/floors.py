@@ -280,7 +280,7 @@ def run_net(ctx, case):
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             timeout=_timeout(case), stdin=subprocess.DEVNULL)
         with open(ctx.log(case, "source"), "w") as f:
-            f.write(cp.stdout)
+            f.write("$ %s\n%s" % (" ".join(cp.args), cp.stdout))
         if cp.returncode == procs.EXIT_SKIP:
             raise Skip(cp.stdout.strip().splitlines()[-1] if cp.stdout.strip() else "skipped")
         if cp.returncode != 0:

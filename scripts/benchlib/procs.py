@@ -30,6 +30,8 @@ class Failed(Exception):
 def start_background(argv, log_path):
     """Start a partner process (echo, iox-roudi) with output to log_path."""
     log = open(log_path, "w")
+    log.write("$ %s\n" % " ".join(argv))  # the exact command, for the reports
+    log.flush()
     p = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                          start_new_session=True)
     log.close()

@@ -532,6 +532,19 @@ def _cmd(argv):
     return " ".join(out)
 
 
+def _logged_command(name, what):
+    """The "$ command" line a floor program's log starts with."""
+    if not _OUTDIR[0]:
+        return None
+    path = os.path.join(_OUTDIR[0], "logs", "%s.%s.log" % (name, what))
+    try:
+        with open(path, errors="replace") as f:
+            line = f.readline()
+    except OSError:
+        return None
+    return line[2:].split() if line.startswith("$ ") else None
+
+
 def _commands(R):
     pick = [("on-target, ccomm (one process: sender thread on CPU A, receive thread on CPU B)",
              "ccomm_shm_state_block_1khz_p8", "command"),
@@ -543,6 +556,14 @@ def _commands(R):
         r = R.get(name)
         if r and r.get(key):
             out.append("- %s:\n\n  ```\n  %s\n  ```" % (label, _cmd(r[key])))
+    floors = [("shared-memory floor", "shm_spin_b2b_p8", ("run",)),
+              ("raw floor, one-way (receiver, then sender)", "net_raw_oneway_1khz_p8~1", ("sink", "source")),
+              ("LCM (echo, then ping)", "lcm_netns_rtt_half_1khz_p8", ("echo", "ping")),
+              ("iceoryx (echo, then ping; a private iox-roudi runs meanwhile)", "iox_spin_b2b_p8", ("echo", "ping"))]
+    for label, name, whats in floors:
+        cmds = [c for c in (_logged_command(name, w) for w in whats) if c]
+        if cmds:
+            out.append("- %s:\n\n  ```\n%s\n  ```" % (label, "\n".join("  " + _cmd(c) for c in cmds)))
     return "\n".join(out)
 
 

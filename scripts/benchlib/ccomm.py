@@ -409,10 +409,14 @@ def delta_stats(before, after, src, dst):
 
     rx = d("frames_rx", dst, src)
     hb = d("heartbeats_rx", dst, src)
+    tx = d("frames_tx", src, dst)
     return {
-        "frames_tx": d("frames_tx", src, dst),
+        "frames_tx": tx,
         "frames_rx": rx,
-        "data_frames": rx - hb,
+        # Frames with data: what the sender sent minus the heartbeats among them (the
+        # receiver counts those); the receiver's own count must agree without loss.
+        "data_frames": tx - hb,
+        "data_frames_rx": rx - hb,
         "heartbeats": hb,
         "frames_lost": d("frames_lost", dst, src),
         "frames_reordered": d("frames_reordered", dst, src),

@@ -168,8 +168,8 @@ def checks(R, meta):
             continue
         ok = all(abs(x - 1.0) <= 0.02 for x in vals)
         at1k = [r for r in rows if r["rate_hz"] == 1000]
-        how = ("data frames the far ccommd received (frames_rx - heartbeats_rx in `ccomm stats --json`) / cycles "
-               "sent, whole run" if mode == "event" else
+        how = ("frames_tx of the sending ccommd minus the heartbeats among them (`ccomm stats --json` before and "
+               "after, the receiver's heartbeats_rx) / cycles the application sent, whole run" if mode == "event" else
                "packets sent on eth0 per cycle in the steady part of the run (periodic frames continue "
                "after the applications stop, so whole-run counters do not apply)")
         detail = "%s: %.3f..%.3f over %d runs%s" % (
@@ -717,7 +717,7 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
             L.append("")
         fr = [r for r in sec if r.get("frames_per_cycle") is not None]
         if fr:
-            L.append("Frames per cycle on the wire (data frames received by the far ccommd / cycles sent): " +
+            L.append("Frames per cycle (the sending ccommd's frames_tx minus heartbeats / cycles sent): " +
                      ", ".join("`%s` %s" % (r["name"], r["frames_per_cycle"]) for r in fr) + ".\n")
 
     if any(r.get("section") == "thesis" for r in rows):

@@ -66,8 +66,9 @@ def _series(outdir, rows):
     return out
 
 
-def _cdf_figure(plt, outdir, rows, title, path, label=None):
-    """CDF and tail (P(latency > x), log) of the rows' raw samples; False if none."""
+def _cdf_figure(plt, outdir, rows, title, path, label=None, style_of=None):
+    """CDF and tail (P(latency > x), log) of the rows' raw samples; False if none.
+    style_of(row, k): matplotlib line style, default: 20 colours then dashed."""
     series = _series(outdir, rows)
     if not series:
         return False
@@ -79,7 +80,8 @@ def _cdf_figure(plt, outdir, rows, title, path, label=None):
         x = [ns / 1000.0 for ns in v]
         y = [(i + 1) / n for i in range(n)]
         # 20 distinct colours, then the same with dashes: no two rows look alike.
-        style = {"color": cmap(k % 20), "linestyle": "-" if k < 20 else "--", "linewidth": 1}
+        style = style_of(r, k) if style_of else {"color": cmap(k % 20), "linestyle": "-" if k < 20 else "--",
+                                                  "linewidth": 1}
         ax1.plot(x, y, label=label(r), **style)
         # Survival: P(latency > x); 1/n floor so the last point stays on a log axis.
         ax2.plot(x, [max(1.0 - yy, 1.0 / n) for yy in y], **style)
@@ -129,6 +131,32 @@ def _bench_label(r):
     return "%s (%s, %s, %s B, %s)" % (r["name"], r.get("metric", "?"), style, r["payload_bytes"], rate)
 
 
+def _style_by_family(plt, rows):
+    """ccomm solid, floors dashed, peers dotted; one colour per (transport or kind,
+    payload, receive style), so a ccomm row and the floor it is read against match."""
+    cmap = plt.get_cmap("tab10")
+    keys = []
+
+    def key(r):
+        n = r["name"]
+        fam = "iox" if n.startswith("iox") else ("lcm" if n.startswith("lcm") else r["transport"])
+        if fam == "iceoryx":
+            fam = "iox"
+        style = r.get("style") or ("spin" if "_spin_" in n else "block")
+        return (fam if not n.startswith(("iox", "lcm")) else "peer-" + fam, r["payload_bytes"], style)
+
+    for r in rows:
+        if key(r) not in keys:
+            keys.append(key(r))
+
+    def style_of(r, k):
+        n = r["name"]
+        ls = "-" if n.startswith("ccomm") else (":" if n.startswith(("iox", "lcm")) else "--")
+        return {"color": cmap(keys.index(key(r)) % 10), "linestyle": ls,
+                "linewidth": 1.6 if n.startswith("ccomm") else 1.1}
+    return style_of
+
+
 def bench_plots(outdir, rows, plots_dir, thesis_ref=None):
     """scripts/bench's figures, written into plots_dir: on-target and board-to-board
     latency distributions, the thesis sweep against the thesis' min/max, a p50 summary."""
@@ -138,12 +166,19 @@ def bench_plots(outdir, rows, plots_dir, thesis_ref=None):
 
     os.makedirs(plots_dir, exist_ok=True)
     written = []
-    titles = {"ontarget": "on-target, app -> app through shared memory",
-              "b2b": "board -> board, two namespaces joined by veth (1 kHz)"}
-    for sec, title in titles.items():
-        sel = [r for r in rows if r.get("section") == sec]
-        path = os.path.join(plots_dir, "%s_latency.png" % sec)
-        if _cdf_figure(plt, outdir, sel, "latency distribution: " + title, path, _bench_label):
+    figures = [
+        ("ontarget_latency.png", "on-target, app -> app through shared memory",
+         lambda r: r.get("section") == "ontarget"),
+        ("b2b_oneway_latency.png", "board -> board one-way, two namespaces joined by veth, 1 kHz",
+         lambda r: r.get("section") == "b2b" and r.get("metric") == "one_way"),
+        ("b2b_rtt_latency.png", "board -> board RTT/2 (ping-pong), ccomm, floors and LCM, 1 kHz",
+         lambda r: r.get("section") == "b2b" and r.get("metric") != "one_way"),
+    ]
+    for fname, title, pick in figures:
+        sel = [r for r in rows if pick(r)]
+        path = os.path.join(plots_dir, fname)
+        if _cdf_figure(plt, outdir, sel, "latency distribution: " + title, path, _bench_label,
+                       _style_by_family(plt, sel)):
             written.append(path)
 
     th = [r for r in rows if r.get("section") == "thesis"]

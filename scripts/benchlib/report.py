@@ -731,7 +731,12 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
                  "`rate_hz` = the send rate. \"app missed\": cycles the receiving application never saw "
                  "complete; \"wire lost\": frames missing in ccommd's sequence numbers / values ccommd counted "
                  "as lost. The thesis' figures were measured on different hardware over a real switch: compare "
-                 "shape (how latency grows with the rate), not absolute values.\n")
+                 "shape (how latency grows with the rate), not absolute values. Two things to know when reading "
+                 "the rows: in periodic mode every cycle is also sent at once when the application flushes (see "
+                 "Targets), so its latency columns show that immediate copy, not a wait for the period; and at "
+                 "low rates the CPUs idle between cycles, so each wake-up starts from an idle (on this virtual "
+                 "machine: halted) CPU, which is why p50 falls as the rate rises (compare `shm_futex_b2b_p8` "
+                 "with `shm_futex_1khz_p8` in section 1 for the same effect on a bare futex).\n")
         L.append(_thesis_tables(R))
         L.append(_spin_table(R))
         fs = []

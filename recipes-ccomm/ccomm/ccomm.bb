@@ -34,17 +34,20 @@ PV = "${@ccomm_version(d)}"
 # No network fetch of the project: the layer is the repository root, and FILESPATH is
 # extended to it, so these file:// entries are this checkout's own CMake project. Their
 # content checksums (not their path) go into the task signatures, so an edit rebuilds.
-# cmake/ only holds the Xenomai find module today, so it is fetched only for that build.
+# examples/ and docs/protocol.md are test data of config_test and wire_test.
 # nooelint: oelint.vars.fileextrapaths,oelint.vars.outofcontext - the sources live at the layer root
 FILESEXTRAPATHS:prepend := "${CCOMM_LAYERDIR}:"
 SRC_URI = "file://CMakeLists.txt;subdir=${BP} \
+           file://cmake;subdir=${BP} \
            file://src;subdir=${BP} \
            file://dist;subdir=${BP} \
-           ${@bb.utils.contains('PACKAGECONFIG', 'xenomai', 'file://cmake;subdir=${BP}', '', d)} \
+           file://integrations;subdir=${BP} \
+           ${@bb.utils.contains('PACKAGECONFIG', 'ptest', 'file://examples;subdir=${BP} file://docs/protocol.md;subdir=${BP}', '', d)} \
            file://run-ptest \
            "
 
-inherit cmake systemd pkgconfig ptest
+# python3native: integrations/ generates the 20-sim example code with Python at build time
+inherit cmake systemd pkgconfig ptest useradd python3native
 
 PACKAGECONFIG ??= "sodium ${@bb.utils.filter('DISTRO_FEATURES', 'ptest systemd', d)}"
 # the unit tests (GoogleTest) are built only to ship them in ${PN}-ptest
@@ -60,6 +63,8 @@ PACKAGECONFIG[xenomai] = "-DCCOMM_WITH_XENOMAI=ON -DXENO_CONFIG=${STAGING_BINDIR
 # not break a distro build over a new warning.
 EXTRA_OECMAKE = "-DCCOMM_SYSTEMD_UNITDIR=${systemd_system_unitdir} \
                  -DCCOMM_CONFDIR=${sysconfdir}/ccomm \
+                 -DCCOMM_SYSUSERSDIR=${nonarch_libdir}/sysusers.d \
+                 -DCCOMM_BUILD_BENCH=OFF \
                  -DCCOMM_SANITIZE= \
                  -DCCOMM_WERROR=OFF \
                  "
@@ -74,19 +79,32 @@ do_install_ptest() {
     done
     # a ptest package without tests would report success on the board: fail here instead
     [ "$found" = 1 ] || bbfatal "no *_test executables in ${B}/bin"
+    # data the tests read from the source tree; run-ptest points CCOMM_SOURCE_DIR here
+    install -d ${D}${PTEST_PATH}/source/dist ${D}${PTEST_PATH}/source/docs ${D}${PTEST_PATH}/source/examples
+    install -m 0644 ${S}/dist/signals.xml ${D}${PTEST_PATH}/source/dist/
+    install -m 0644 ${S}/docs/protocol.md ${D}${PTEST_PATH}/source/docs/
+    install -m 0644 ${S}/examples/*.xml ${D}${PTEST_PATH}/source/examples/
 }
 
-PACKAGE_BEFORE_PN = "lib${BPN} ${PN}-cli"
+PACKAGE_BEFORE_PN = "lib${BPN} ${PN}-cli ${PN}-integrations"
 
 SYSTEMD_SERVICE:${PN} = "ccommd.service"
 SYSTEMD_AUTO_ENABLE:${PN} = "enable"
 
+# ccommd.service runs as User=ccomm; dist/ccomm.sysusers.conf describes the same account
+# for systemd-sysusers, created here at build time so a read-only rootfs has it too
+USERADD_PACKAGES = "${PN}"
+USERADD_PARAM:${PN} = "--system --user-group --home-dir / --no-create-home --shell ${base_sbindir}/nologin ccomm"
+
 FILES:lib${BPN} += "${libdir}/libccomm${SOLIBS}"
-FILES:${PN}-cli += "${bindir}/ccomm"
-FILES:${PN} += "${systemd_system_unitdir}/ccommd.service"
+FILES:${PN}-cli += "${bindir}/ccomm ${bindir}/ccomm-latency"
+# 20-sim / Simulink templates and generators (Python scripts)
+FILES:${PN}-integrations += "${datadir}/ccomm/integrations"
+FILES:${PN} += "${systemd_system_unitdir}/ccommd.service ${nonarch_libdir}/sysusers.d/ccomm.conf"
 
 CONFFILES:${PN} = "${sysconfdir}/ccomm/signals.xml"
 
+RDEPENDS:${PN}-integrations = "python3-core"
 # the CLI is how a person (and the oeqa test) reads and writes signals on the board
 RRECOMMENDS:${PN} = "${PN}-cli"
 

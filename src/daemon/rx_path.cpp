@@ -48,8 +48,12 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   } else if (ahead < 0x80000000u) {
     ps.frames_lost.fetch_add(ahead, std::memory_order_relaxed);
     pr.expected = h.seq + 1;
-  } else if (h.send_time_ns > pr.last_send_ns || now - pr.last_rx_ns > peer_timeout_ns_) {
-    // A lower seq sent later than anything seen (or after silence): the peer restarted.
+  } else if (h.send_time_ns > pr.last_send_ns ||
+             (now - pr.last_rx_ns > peer_timeout_ns_ && h.send_time_ns <= now - pr.last_rx_ns)) {
+    // A lower seq sent later than anything seen: the peer's ccommd restarted. Or both went
+    // back after a silence longer than the sender's clock is old: the board rebooted in
+    // the meantime. (A frame that is merely late, even after a silence, was sent on an
+    // older clock than that: it must not roll the values back.)
     // Its value sequence numbers may restart too.
     Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)",
         cfg_->nodes[h.sender].name.c_str(), h.seq, pr.expected);

@@ -21,7 +21,7 @@ IMAGE_LINGUAS = ""
 # $CCOMM_NODE say otherwise), so the image's hostname is the board's node. Build the
 # other board's image with CCOMM_NODE = "planner" (default signals.xml).
 CCOMM_NODE ?= "control"
-ROOTFS_POSTPROCESS_COMMAND += "ccomm_set_node;"
+ROOTFS_POSTPROCESS_COMMAND += "ccomm_set_node"
 ccomm_set_node[doc] = "Write the board's ccomm node name (CCOMM_NODE) to /etc/hostname"
 ccomm_set_node() {
     echo "${CCOMM_NODE}" > ${IMAGE_ROOTFS}${sysconfdir}/hostname

@@ -100,6 +100,10 @@ int CmdList(ccomm_client* c) {
       ccomm_info info;
       int r = ccomm_read(c, i, buf.data(), buf.size(), &info);
       status = r >= 0 ? StatusWord(r) : ccomm_strerror(r);
+      if (r >= 0 && (info.flags & CCOMM_INFO_SAFE_VALUE)) {
+        status += "*";  // the value shown is the configured safe value
+        value = ccomm::cli::FormatValue(d, buf.data());
+      }
       if (r == CCOMM_FRESH || r == CCOMM_STALE) {
         value = ccomm::cli::FormatValue(d, buf.data());
         snprintf(age, sizeof age, "%.1f", static_cast<double>(info.age_ns) / 1e6);

@@ -86,7 +86,9 @@ static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* 
       *error = "'" + w + "' is not a bool (0, 1, true, false)";
       return false;
     case CCOMM_INT32: case CCOMM_INT64: {
-      long long v = strtoll(s, &end, 0);
+      // Decimal, or hexadecimal with 0x (as in signals.xml); a leading 0 is not octal.
+      int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) || (s[0] == '-' && s[1] == '0' && (s[2] == 'x' || s[2] == 'X')) ? 16 : 10;
+      long long v = strtoll(s, &end, base);
       if (*s == '\0' || *end || errno || (type == CCOMM_INT32 && (v < INT32_MIN || v > INT32_MAX))) {
         *error = "'" + w + "' is not a valid " + TypeName(type);
         return false;
@@ -96,7 +98,8 @@ static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* 
       return true;
     }
     case CCOMM_UINT32: {
-      unsigned long long v = strtoull(s, &end, 0);
+      int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) ? 16 : 10;
+      unsigned long long v = strtoull(s, &end, base);
       if (*s == '\0' || *s == '-' || *end || errno || v > UINT32_MAX) {
         *error = "'" + w + "' is not a valid uint32";
         return false;
@@ -138,7 +141,8 @@ bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std:
   }
   if (parts.size() != 1 && parts.size() != d.count) {
     char buf[96];
-    snprintf(buf, sizeof buf, "expected 1 or %u values, got %zu", d.count, parts.size());
+    if (d.count == 1) snprintf(buf, sizeof buf, "expected 1 value, got %zu", parts.size());
+    else snprintf(buf, sizeof buf, "expected 1 or %u values, got %zu", d.count, parts.size());
     *error = buf;
     return false;
   }

@@ -129,6 +129,7 @@ int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out
   out->value_bytes = d.value_bytes;
   out->is_event = (d.flags & st::kSigEvent) ? 1 : 0;
   out->produced_here = (d.flags & st::kSigProducedHere) ? 1 : 0;
+  out->consumed_here = (d.flags & st::kSigConsumedHere) ? 1 : 0;
   out->stale_after_ms = d.stale_after_ms;
   out->producer = d.producer < c->segment.node_count() ? c->segment.node_name(d.producer) : "";
   return 0;
@@ -269,8 +270,15 @@ int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v) {
 
 int ccomm_flush(ccomm_client* c) {
   if (!c) return CCOMM_E_INVAL;
-  if (c->pending_tx) c->segment.RingTxDoorbell();
-  if (c->pending_rx) c->segment.NotifyRx();
+  const bool quiet = (c->flags & CCOMM_OPEN_NO_DOORBELL) != 0;  // no syscall, even here
+  if (c->pending_tx) {
+    if (quiet) c->segment.header()->tx_doorbell.fetch_add(1, std::memory_order_release);
+    else c->segment.RingTxDoorbell();
+  }
+  if (c->pending_rx) {
+    if (quiet) c->segment.header()->rx_doorbell.fetch_add(1, std::memory_order_release);
+    else c->segment.NotifyRx();
+  }
   c->pending_tx = c->pending_rx = false;
   return 0;
 }

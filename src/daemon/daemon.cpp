@@ -81,6 +81,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   int r = segment_.CreateOrAdopt(cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
   reclaim_suspects_.assign(store::SlotCount(segment_), 0);
+  for (uint32_t p = 0; p < m; ++p) segment_.peer(p).alive.store(0);  // a re-adopted segment's are stale
   if (adopted_) {
     // Writers that died while this ccommd was down may have left slots half-written.
     size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);

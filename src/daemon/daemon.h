@@ -103,6 +103,7 @@ class Daemon {
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
   std::vector<uint64_t> reclaim_suspects_;        // slot -> odd seq seen at the last scan
   uint64_t next_reclaim_ns_ = 0;
+  bool wrong_hash_logged_ = false;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_value_[kMaxValueBytes];

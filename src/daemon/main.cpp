@@ -17,6 +17,8 @@
 #include "daemon/daemon.h"
 #include "daemon/privileges.h"
 #include "daemon/sd_notify.h"
+#include "store/layout.h"
+#include "wire/wire.h"
 
 // Hooks for the allocation-counting test (tests/alloc_counter.cpp preloads them);
 // weak, so they cost nothing in a normal run.
@@ -34,7 +36,7 @@ const char kUsage[] =
     "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
     "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
     "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
-    "  -v, --verbose         more log output (repeat for debug)\n"
+    "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
     "  -q, --quiet           warnings and errors only\n"
     "  -h, --help            this text\n"
     "  -V, --version         version\n"
@@ -90,7 +92,8 @@ int main(int argc, char** argv) {
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
       case 'q': verbosity = 4; break;
       case 'h': fputs(kUsage, stdout); return 0;
-      case 'V': printf("ccommd %s (wire v1, shm layout v1)\n", CCOMM_VERSION); return 0;
+      case 'V': printf("ccommd %s (wire v%u, shm layout v%u)\n", CCOMM_VERSION, unsigned{wire::kVersion},
+                       store::kLayoutVersion); return 0;
       default: fputs(kUsage, stderr); return 2;
     }
   }
@@ -123,8 +126,10 @@ int main(int argc, char** argv) {
   if (node < 0) {
     std::string names;
     for (const auto& n : cfg.nodes) names += (names.empty() ? "" : ", ") + n.name;
-    fprintf(stderr, "ccommd: %s has no node '%s' (nodes: %s); pass --node NAME or set the hostname\n",
-            opt.config_path.c_str(), opt.node.c_str(), names.c_str());
+    const char* from = getenv("CCOMM_NODE") && *getenv("CCOMM_NODE") && opt.node == getenv("CCOMM_NODE")
+                           ? "from $CCOMM_NODE" : "from --node or the hostname";
+    fprintf(stderr, "ccommd: %s has no node '%s' (%s; nodes: %s): pass --node NAME, set CCOMM_NODE, "
+            "or set the hostname\n", opt.config_path.c_str(), opt.node.c_str(), from, names.c_str());
     return 1;
   }
 

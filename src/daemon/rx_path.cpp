@@ -30,6 +30,12 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   }
   if (h.config_hash != cfg_->hash) {
     Count(store::kFramesWrongHash);
+    if (!wrong_hash_logged_) {  // once: the counter tells how often
+      wrong_hash_logged_ = true;
+      Log(LogLevel::kWarning, "frames from node '%s' carry config hash %08x, ours is %08x: the boards run "
+          "different signals.xml files; their frames are dropped (see ccomm stats)",
+          cfg_->nodes[h.sender].name.c_str(), h.config_hash, cfg_->hash);
+    }
     return;
   }
   if (auth_.enabled() &&

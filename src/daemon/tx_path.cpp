@@ -84,6 +84,8 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 
+constexpr uint64_t kMaxSleepNs = 100ull * 1000 * 1000;
+
 void Daemon::RunTx() {
   const NodeConfig& self = cfg_->nodes[self_];
   if (!opt_.no_realtime) {
@@ -108,10 +110,13 @@ void Daemon::RunTx() {
         uint32_t b = static_cast<uint32_t>(__builtin_ctzll(bits));
         bits &= bits - 1;
         uint32_t id = w * 64 + b;
-        if (id < segment_.signal_count() && !consumers_[id].empty()) CollectSignal(id, now, false);
+        // Periodic signals leave on their period only (not early with another write).
+        if (id < segment_.signal_count() && !consumers_[id].empty() && !cfg_->signals[id].period_us)
+          CollectSignal(id, now, false);
       }
     }
-    uint64_t next_deadline = now + heartbeat_ns_;
+    // Wake at least every 100 ms even when idle: the watchdog needs this loop to advance.
+    uint64_t next_deadline = now + (heartbeat_ns_ < kMaxSleepNs ? heartbeat_ns_ : kMaxSleepNs);
     for (uint32_t id : periodic_) {
       if (now >= due_ns_[id]) {
         CollectSignal(id, now, true);

@@ -216,9 +216,7 @@ std::vector<ccomm_signal> Resolve(ccomm_client* c, const std::string& list, bool
     ccomm_signal_desc d;
     ccomm_describe(c, i, &d);
     if (d.type != CCOMM_DOUBLE || d.count != 1 || d.is_event) continue;
-    bool here = d.produced_here != 0;
-    bool mine = strcmp(d.producer, ccomm_node_name(c)) == 0;
-    if (produced ? here : !mine) out.push_back(i);
+    if (produced ? d.produced_here : d.consumed_here) out.push_back(i);
   }
   return out;
 }

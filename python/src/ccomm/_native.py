@@ -36,6 +36,7 @@ class SignalDesc(ctypes.Structure):
         ("produced_here", ctypes.c_int32),
         ("stale_after_ms", ctypes.c_uint32),
         ("producer", ctypes.c_char_p),
+        ("consumed_here", ctypes.c_int32),
     ]
 
 

@@ -8,7 +8,8 @@
  *   - ccomm_read* and ccomm_write* are real-time safe: lock-free, wait-free in practice
  *     (bounded retries), no allocation, no blocking, no syscall -- except that a write
  *     of a signal forwarded event-driven by ccommd rings a doorbell (one non-blocking
- *     FUTEX_WAKE) when the daemon is asleep. Open with CCOMM_OPEN_NO_DOORBELL to make
+ *     FUTEX_WAKE) when the daemon is asleep, and any write wakes local ccomm_wait()
+ *     callers (one FUTEX_WAKE) if there are any. Open with CCOMM_OPEN_NO_DOORBELL to make
  *     writes syscall-free (e.g. a Xenomai primary-mode thread); ccommd then sends at its
  *     periodic cycle or heartbeat instead of at once.
  *   - ccomm_wait blocks and is meant for non-real-time consumers.
@@ -90,6 +91,7 @@ typedef struct ccomm_signal_desc {
   int32_t produced_here;   /**< 1 if this node may write it */
   uint32_t stale_after_ms; /**< 0 = never stale */
   const char* producer;    /**< producer node name */
+  int32_t consumed_here;   /**< 1 if produced elsewhere and delivered to this node */
 } ccomm_signal_desc;
 
 /**

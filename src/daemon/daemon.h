@@ -13,6 +13,7 @@
 #include "config/config.h"
 #include "daemon/auth.h"
 #include "daemon/transport.h"
+#include "store/reclaim.h"
 #include "store/segment.h"
 #include "wire/wire.h"
 
@@ -101,7 +102,7 @@ class Daemon {
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
-  std::vector<uint64_t> reclaim_suspects_;        // slot -> odd seq seen at the last scan
+  std::vector<store::SlotSuspect> reclaim_suspects_;  // slot -> what the last scan saw
   uint64_t next_reclaim_ns_ = 0;
   bool wrong_hash_logged_ = false;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;

@@ -30,26 +30,26 @@ size_t SlotCount(const Segment& s) {
   return n;
 }
 
-size_t ReclaimAbandonedSlots(const Segment& s, std::vector<uint64_t>* suspects) {
+size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspects) {
   size_t i = 0, reclaimed = 0;
   ForEachSlot(s, [&](SlotHeader* h) {
-    uint64_t& prev = (*suspects)[i++];
+    SlotSuspect& prev = (*suspects)[i++];
     uint64_t seq = h->seq.load(std::memory_order_acquire);
     if (!(seq & 1)) {
-      prev = 0;
+      prev = SlotSuspect();
       return;
     }
     uint64_t ticket = (seq - 1) / 2;
     uint64_t owner = h->owner.load(std::memory_order_acquire);
     bool owner_known = (owner & 0xffffffffu) == (ticket & 0xffffffffu);
+    prev.scans = (!owner_known && prev.seq == seq) ? prev.scans + 1 : 0;
+    prev.seq = seq;
     bool dead = owner_known ? !platform::ProcessAlive(static_cast<uint32_t>(owner >> 32))
-                            : prev == seq;  // claimed, owner never written, unchanged since last scan
+                            : prev.scans >= kUnknownOwnerScans;  // claimed, owner never written
     if (dead) {
       uint64_t expected = seq;
       if (h->seq.compare_exchange_strong(expected, 0, std::memory_order_acq_rel)) reclaimed++;
-      prev = 0;
-    } else {
-      prev = seq;
+      prev = SlotSuspect();
     }
   });
   return reclaimed;

@@ -4,11 +4,13 @@
 // A slot is odd while its writer copies the value. If the writer dies, the slot stays
 // odd: state cells lose one of their kStateSlots copies, event rings get a hole every
 // lap. ccommd calls ReclaimAbandonedSlots about once a second. A slot is freed (seq -> 0,
-// which readers never accept and writers may claim) only when its writer is provably
-// gone: the owner word names a pid that no longer exists, or the writer died before it
-// could write the owner word (the slot was odd with the same seq at the previous scan
-// and its owner word names an older ticket). A slow but live writer is never touched,
-// so its late stores can never land in a reused slot.
+// which readers never accept and writers may claim) only when its writer is gone: the
+// owner word names a pid that no longer exists, or the writer died before it could
+// write the owner word (owner names an older ticket, and the slot stayed odd with the
+// same seq for kUnknownOwnerScans scans, i.e. seconds, for two instructions' work).
+// A slow but live writer is not touched, so its late stores never land in a reused slot.
+// Limit: pids are those of ccommd's pid namespace; writers in another pid namespace
+// (a container with its own) must not share a segment with this ccommd.
 #pragma once
 
 #include <cstdint>
@@ -19,12 +21,19 @@
 namespace ccomm {
 namespace store {
 
-/// Per-slot memory between scans; size it once with SlotCount() (start-up only).
+/// What a scan remembers of one slot for the next.
+struct SlotSuspect {
+  uint64_t seq = 0;    // odd seq seen, 0 = slot was not odd
+  uint32_t scans = 0;  // consecutive scans it was seen odd with that seq and no owner
+};
+constexpr uint32_t kUnknownOwnerScans = 5;
+
+/// Number of slots in the segment; size the suspects vector with it (start-up only).
 size_t SlotCount(const Segment& s);
 
 /// Scans every slot; returns how many were reclaimed. `suspects` must have
-/// SlotCount(s) entries (zeros initially). Makes one kill(pid, 0) per odd slot.
-size_t ReclaimAbandonedSlots(const Segment& s, std::vector<uint64_t>* suspects);
+/// SlotCount(s) entries. Makes one kill(pid, 0) per odd slot with a known owner.
+size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspects);
 
 }  // namespace store
 }  // namespace ccomm

@@ -89,7 +89,7 @@ TEST(Stress, WritersKilledAtRandomNeverCorruptReaders) {
   if (reclaimer == 0) {
     Segment s;
     if (s.Open(name) != 0) _exit(10);
-    std::vector<uint64_t> suspects(SlotCount(s), 0);
+    std::vector<SlotSuspect> suspects(SlotCount(s));
     size_t total = 0;
     while (platform::MonotonicNs() < until + 500000000ull) {
       total += ReclaimAbandonedSlots(s, &suspects);

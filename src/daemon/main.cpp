@@ -167,8 +167,16 @@ int main(int argc, char** argv) {
   else Log(LogLevel::kInfo, "%s", privileges.c_str());
 
   pthread_t tx, rx;
-  pthread_create(&tx, nullptr, TxThread, &daemon);
-  pthread_create(&rx, nullptr, RxThread, &daemon);
+  if (int e = pthread_create(&tx, nullptr, TxThread, &daemon)) {
+    Log(LogLevel::kError, "ccommd: cannot start the send thread: %s", strerror(e));
+    return 3;
+  }
+  if (int e = pthread_create(&rx, nullptr, RxThread, &daemon)) {
+    Log(LogLevel::kError, "ccommd: cannot start the receive thread: %s", strerror(e));
+    daemon.RequestStop();
+    pthread_join(tx, nullptr);
+    return 3;
+  }
   sd::NotifyReady();
   if (ccomm_steady_state_begin) ccomm_steady_state_begin();
 

@@ -25,7 +25,7 @@ use_transport() {
 	for b in $QT_BOARDS; do
 		vm "$b" "set -e
 sed 's/transport=\"[a-z]*\"/transport=\"$t\"/' /run/ccq/signals.xml.orig >/run/ccq/signals-$t.xml
-ccommd --check /run/ccq/signals-$t.xml
+ccommd --check /run/ccq/signals-$t.xml >/dev/null
 cp /run/ccq/signals-$t.xml /etc/ccomm/signals.xml
 systemctl restart ccommd" || return 1
 	done
@@ -45,6 +45,8 @@ uses_transport() {
 }
 
 # Publishes one distinct value per signal on FROM, then checks every value on TO.
+# A signal with a safe value reads as that safe value once stale (20 ms after the
+# write): those are checked while FROM keeps writing them at 100 Hz.
 values_arrive() {
 	local from=$1 to=$2 base=$3 cmds= i=0 s
 	declare -A want
@@ -54,58 +56,91 @@ values_arrive() {
 		cmds+="ccomm pub $s ${want[$s]} || echo 'pub $s failed'; "
 	done
 	vm "$from" "$cmds" || return 1
-	nap_host 0.5
-	local list bad=0
+	sleep 0.5
+	local list bad=0 again= row
 	list=$(vm "$to" 'ccomm list')
 	for s in ${PRODUCES[$from]}; do
-		local row
 		row=$(awk -v s="$s" '$2 == s' <<<"$list")
-		# STATUS is stale by now (stale_after_ms=20 and no new write), the value stays.
-		if [ "$(awk '{print $8}' <<<"$row")" != "${want[$s]}" ]; then
+		[ "$(awk '{print $8}' <<<"$row")" = "${want[$s]}" ] && continue
+		if [[ $(awk '{print $6}' <<<"$row") == stale* ]]; then
+			again+=" $s"
+		else
 			echo "  $to: $s: want ${want[$s]}, have: $row"
 			bad=$((bad + 1))
 		fi
 	done
+	if [ -n "$again" ]; then
+		# Arrival-driven: readers on TO wait for the next update of each signal (which
+		# is fresh when it arrives) while FROM rewrites the values at 20 Hz.
+		local job= readers= s2 out
+		for s in $again; do
+			job+="ccomm pub $s ${want[$s]} --rate 20 --count 400 & "
+			readers+="ccomm echo $s -n 2 --timeout 20 >/run/ccq-val-$s.out 2>&1 & "
+		done
+		vm_bg "$to" readers "$readers wait" >/dev/null
+		sleep 1
+		vm_bg "$from" values "$job wait" >/dev/null
+		vm_bg_wait "$to" readers 40 >/dev/null
+		out=$(vm "$to" "for s in $again; do tail -n 1 /run/ccq-val-\$s.out; done")
+		local job_out
+		job_out=$(vm_bg_stop "$from" values)
+		for s in $again; do
+			row=$(awk -v s="$s" '$1 == s' <<<"$out")
+			if [ "$(awk '{print $2, $3}' <<<"$row")" != "${want[$s]} fresh" ]; then
+				echo "  $to: $s: want ${want[$s]} fresh, last arrival: ${row:-none}"
+				bad=$((bad + 1))
+				s2=1
+			fi
+		done
+		[ -z "${s2:-}" ] || sed 's/^/  writer: /' <<<"$job_out" | head -n 20
+		note "$from -> $to: $(wc -w <<<"$again") signals with a safe value checked on arrival"
+	fi
 	note "$from -> $to: $((i - bad)) of $i values arrived exactly"
 	[ "$bad" = 0 ] && [ "$i" -gt 0 ]
 }
 
-# A 100 Hz stream of N writes one way and of N the other way at the same time: the
-# consumer's `ccomm echo` must see every update fresh; no frame may be lost.
+# A 100 Hz stream of N writes one way and of N the other way at the same time. Exact
+# accounting: every write reaches the other daemon, in a frame of its own or merged
+# into a later one (coalesced), none lost; and the reading application sees the updates
+# arrive fresh.
 N=200
+counters() { # SIGNAL < JSON -> "writes coalesced rx lost"
+	jget "(lambda s: '%d %d %d %d' % (s['writes'], s['coalesced'], s['rx'], s['lost']))([s for s in d['signals'] if s['name'] == '$1'][0])"
+}
+frames_lost() { jget "sum(p['frames_lost'] for p in d['peers'])"; }
 streams_arrive() {
-	local t=$1 ok=0
-	local sig_cp sig_pc
-	sig_cp=$(awk '{print $1}' <<<"${PRODUCES[control]}")
-	sig_pc=$(awk '{print $1}' <<<"${PRODUCES[planner]}")
-	local before_p before_c
-	before_p=$(vm planner 'ccomm stats --json')
-	before_c=$(vm control 'ccomm stats --json')
-	vm_bg planner echo "ccomm echo $sig_cp -n $N --timeout 30" >/dev/null
-	vm_bg control echo "ccomm echo $sig_pc -n $N --timeout 30" >/dev/null
-	nap_host 1
-	vm_bg control pub "ccomm pub $sig_cp 7 --rate 100 --count $((N + 20))" >/dev/null
-	vm_bg planner pub "ccomm pub $sig_pc 9 --rate 100 --count $((N + 20))" >/dev/null
-	local out_p out_c rc_p rc_c
-	out_p=$(vm_bg_wait planner echo 40); rc_p=$?
-	out_c=$(vm_bg_wait control echo 40); rc_c=$?
-	vm_bg_wait control pub 20 >/dev/null
-	vm_bg_wait planner pub 20 >/dev/null
-	local fresh_p fresh_c
-	fresh_p=$(grep -c " fresh " <<<"$out_p")
-	fresh_c=$(grep -c " fresh " <<<"$out_c")
-	note "$t: planner saw $fresh_p fresh updates of $sig_cp (echo exit $rc_p), control $fresh_c of $sig_pc (exit $rc_c)"
-	local after_p after_c
-	after_p=$(vm planner 'ccomm stats --json')
-	after_c=$(vm control 'ccomm stats --json')
-	note "$t: planner $sig_cp: $(sig_summary "$sig_cp" <<<"$after_p")"
-	note "$t: control $sig_pc: $(sig_summary "$sig_pc" <<<"$after_c")"
-	note "$t: peers: planner sees $(jget "[(p['frames_rx'], p['frames_lost']) for p in d['peers']]" <<<"$after_p") (frames rx, lost), control $(jget "[(p['frames_rx'], p['frames_lost']) for p in d['peers']]" <<<"$after_c")"
-	local lost
-	lost=$(( $(jget "sum(p['frames_lost'] for p in d['peers'])" <<<"$after_p") - $(jget "sum(p['frames_lost'] for p in d['peers'])" <<<"$before_p") +
-		$(jget "sum(p['frames_lost'] for p in d['peers'])" <<<"$after_c") - $(jget "sum(p['frames_lost'] for p in d['peers'])" <<<"$before_c") ))
-	[ "$rc_p" = 0 ] && [ "$rc_c" = 0 ] && [ "$fresh_p" -ge $((N * 9 / 10)) ] && [ "$fresh_c" -ge $((N * 9 / 10)) ] && ok=1
-	[ "$lost" = 0 ] || { echo "  $t: $lost frames lost during the streams"; ok=0; }
+	local t=$1 ok=1 from to sig
+	declare -A b4 sig_of
+	sig_of[control]=$(awk '{print $1}' <<<"${PRODUCES[control]}")
+	sig_of[planner]=$(awk '{print $1}' <<<"${PRODUCES[planner]}")
+	for b in $QT_BOARDS; do b4[$b]=$(vm "$b" 'ccomm stats --json'); done
+	vm_bg planner echo "ccomm echo ${sig_of[control]} -n 20 --timeout 60" >/dev/null
+	vm_bg control echo "ccomm echo ${sig_of[planner]} -n 20 --timeout 60" >/dev/null
+	sleep 1
+	vm_bg control pub "ccomm pub ${sig_of[control]} 7 --rate 100 --count $N" >/dev/null
+	vm_bg planner pub "ccomm pub ${sig_of[planner]} 9 --rate 100 --count $N" >/dev/null
+	for b in $QT_BOARDS; do vm_bg_wait "$b" pub 60 >/dev/null || { echo "  $b: ccomm pub failed"; ok=0; }; done
+	sleep 1
+	declare -A now
+	for b in $QT_BOARDS; do now[$b]=$(vm "$b" 'ccomm stats --json'); done
+	for from in control planner; do
+		to=$([ $from = control ] && echo planner || echo control)
+		sig=${sig_of[$from]}
+		local w0 c0 w1 c1 x r0 l0 r1 l1 fresh rc
+		read -r w0 c0 x x < <(counters "$sig" <<<"${b4[$from]}")
+		read -r w1 c1 x x < <(counters "$sig" <<<"${now[$from]}")
+		read -r x x r0 l0 < <(counters "$sig" <<<"${b4[$to]}")
+		read -r x x r1 l1 < <(counters "$sig" <<<"${now[$to]}")
+		local flost=$(($(frames_lost <<<"${now[$to]}") - $(frames_lost <<<"${b4[$to]}")))
+		local out
+		out=$(vm_bg_wait "$to" echo 60); rc=$?
+		fresh=$(grep -c " fresh " <<<"$out")
+		note "$t: $sig $from -> $to: written $((w1 - w0)), coalesced by the sender $((c1 - c0)), received $((r1 - r0)), lost $((l1 - l0)), frames lost $flost; the reader saw $fresh of 20 updates fresh (exit $rc)"
+		[ $((w1 - w0)) = "$N" ] || { echo "  $from wrote $((w1 - w0)) of $N"; ok=0; }
+		[ $((r1 - r0 + c1 - c0)) = "$N" ] || { echo "  received + coalesced != written"; ok=0; }
+		[ $((l1 - l0)) = 0 ] && [ "$flost" = 0 ] || ok=0
+		[ "$rc" = 0 ] && [ "$fresh" -ge 15 ] || ok=0
+	done
 	[ $ok = 1 ]
 }
 
@@ -121,7 +156,7 @@ for t in raw udp; do
 	base=$([ $t = raw ] && echo 1 || echo 2)
 	check "$t: 36 values control -> planner" values_arrive control planner "$base"
 	check "$t: 9 values planner -> control" values_arrive planner control "$base"
-	check "$t: $N-update streams both ways at 100 Hz, all fresh, no frame lost" streams_arrive $t
+	check "$t: $N-update streams both ways at 100 Hz: every write accounted for, none lost, reader sees them fresh" streams_arrive $t
 done
 use_transport raw >/dev/null || true
 finish

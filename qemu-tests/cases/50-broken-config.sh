@@ -37,7 +37,7 @@ broken_cycle() {
 	check "$what: the service stays down" eval "! vm $B 'systemctl is-active -q ccommd'"
 	local journal
 	journal=$(vm $B "journalctl -u ccommd --since @$since --no-pager -o cat")
-	grep -m 3 "$CFG:" <<<"$journal" | sed "s/^/  journal: /"
+	grep -m 1 "$CFG:" <<<"$journal" | sed "s/^/  journal: /"
 	check "$what: the journal shows $CFG:$line" grep -q "$CFG:$line\\b" <<<"$journal"
 	check "$what: the peer (control) sees planner down" \
 		wait_until 10 eval "vm control 'ccomm stats --json' | jcheck 'not any(p[\"alive\"] for p in d[\"peers\"])'"

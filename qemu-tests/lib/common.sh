@@ -132,3 +132,12 @@ sig_summary() {
 peer_summary() {
 	jget "' '.join('%s: alive=%s frames_rx=%d lost=%d down_transitions=%d last_rx_age_ms=%.0f' % (p['name'], p['alive'], p['frames_rx'], p['frames_lost'], p['down_transitions'], p['last_rx_age_ms']) for p in d['peers'])"
 }
+# arrives_fresh BOARD SIGNAL VALUE [TIMEOUT]: new updates of SIGNAL reach an
+# application on BOARD, fresh, with VALUE. Arrival-driven (ccomm echo waits for the
+# next update) rather than sampling "is it fresh now": on a loaded emulated board a
+# 100 Hz writer's gaps often exceed a 20 ms stale_after_ms, arrivals are fresh.
+arrives_fresh() {
+	local t=${4:-15} out
+	out=$(vm --timeout $((t + 10)) "$1" "ccomm echo $2 -n 3 --timeout $t") || return 1
+	tail -n 2 <<<"$out" | awk -v want="$3 fresh" '$2 " " $3 == want {ok = 1} END {exit !ok}'
+}

@@ -60,7 +60,9 @@ def run(path, command, timeout):
     """Runs COMMAND on the board whose control port is the QEMU pipe chardev PATH
     (PATH.in to QEMU, PATH.out from QEMU). A pipe chardev is always connected, so
     the agent's read blocks instead of polling for a host connection."""
-    deadline = time.monotonic() + timeout + 5  # guest-side timeout first, then ours
+    # The agent's own timeout first (it kills the command, then reports which threads
+    # were busy, which takes a few seconds), then ours.
+    deadline = time.monotonic() + timeout + 10
     req_id = "%d-%d" % (os.getpid(), int(time.monotonic() * 1e6))
     body = command.encode()
     lock = _lock(path, deadline)

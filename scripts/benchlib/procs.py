@@ -80,6 +80,12 @@ def run_measurement(argv, timeout, log_path=None):
         cp = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             timeout=timeout, stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired as e:
+        if log_path:  # what it printed before it hung
+            def text(x):
+                return x.decode(errors="replace") if isinstance(x, bytes) else (x or "")
+            with open(log_path, "w") as f:
+                f.write("$ %s\n%s\n--- stderr ---\n%s\n--- timed out after %ss ---\n" % (
+                    " ".join(argv), text(e.stdout), text(e.stderr), timeout))
         raise Failed("%s timed out after %ss" % (os.path.basename(argv[0]), timeout)) from e
     if log_path:
         with open(log_path, "w") as f:

@@ -145,9 +145,11 @@ def checks(R, meta):
             ok = None if x is None else x <= TARGETS["b2b_raw_ratio"]
             detail = "n/a (row missing)" if x is None else "ccomm p50 %s µs vs floor %s µs = %.2fx%s" % (
                 us(c["p50_ns"]), us(f["p50_ns"]), x,
-                "" if ok else " (over by %.0f%%)" % ((x / TARGETS["b2b_raw_ratio"] - 1) * 100))
-            out.append(_check("board->board %s one-way, %d B: ccomm p50 <= 1.3x the %s floor" % (t, p, t), ok,
-                              detail, "b2b"))
+                "" if ok else " (over by %.1f%%)" % ((x / TARGETS["b2b_raw_ratio"] - 1) * 100))
+            ck = _check("board->board %s one-way, %d B: ccomm p50 <= 1.3x the %s floor" % (t, p, t), ok,
+                        detail, "b2b")
+            ck["rows"] = ("ccomm_%s_oneway_block_1khz_p%d" % (t, p), "net_%s_oneway_1khz_p%d" % (t, p))
+            out.append(ck)
     # 2. below LCM, like with like (both RTT/2 at 1 kHz), and one-way against LCM's RTT/2.
     for cname, lname in (("ccomm_raw_rtt_half_block_1khz_p8", "lcm_netns_rtt_half_1khz_p8"),
                          ("ccomm_raw_rtt_half_block_1khz_p288", "lcm_netns_rtt_half_1khz_p288"),
@@ -160,23 +162,35 @@ def checks(R, meta):
             "RTT/2 vs RTT/2" if "rtt" in cname else "one-way vs LCM RTT/2"), ok, detail))
     # 3. setup-simulation: one frame per direction per cycle.
     for mode in ("event", "periodic"):
-        rows = R.where(section="thesis", exp="setup", mode=mode)
+        rows = [r for r in R.where(section="thesis", exp="setup", mode=mode) if _style(r) == "block"]
         key = "frames_per_cycle" if mode == "event" else "packets_per_cycle"
         vals = [r[key] for r in rows if r.get(key) is not None]
         if not vals:
             out.append(_check("setup-simulation %s mode: one frame per direction per cycle" % mode, None, "n/a"))
             continue
-        ok = all(abs(x - 1.0) <= 0.02 for x in vals)
+        # Whole cycles only: a frame of the A->B direction must carry all 36 entries.
+        sizes = sorted({round(r["bytes_per_frame"]) for r in rows if r.get("bytes_per_frame")})
+        if mode == "event":
+            ok = all(abs(x - 1.0) <= 0.01 for x in vals)
+            how = ("frames_tx of the sending ccommd minus the heartbeats among them (`ccomm stats --json` before "
+                   "and after; the receiver's heartbeats_rx) / cycles the application sent, whole run")
+        else:
+            # Periodic: at most one frame per period; fewer when ccommd's schedule slips
+            # (a later frame then carries the newest values: last value wins).
+            ok = all(x <= 1.02 for x in vals)
+            how = ("packets sent on eth0 per cycle in the steady part of the run (periodic frames continue "
+                   "after the applications stop, so whole-run counters do not apply)")
+            slow = sorted({r["rate_hz"] for r in rows if (r.get(key) or 1) < 0.98})
+            if slow:
+                how += "; below 1 only at %s Hz, where ccommd did not keep the period (see the 10 kHz checks)" % (
+                    ", ".join("%g" % x for x in slow))
         at1k = [r for r in rows if r["rate_hz"] == 1000]
-        how = ("frames_tx of the sending ccommd minus the heartbeats among them (`ccomm stats --json` before and "
-               "after, the receiver's heartbeats_rx) / cycles the application sent, whole run" if mode == "event" else
-               "packets sent on eth0 per cycle in the steady part of the run (periodic frames continue "
-               "after the applications stop, so whole-run counters do not apply)")
-        detail = "%s: %.3f..%.3f over %d runs%s" % (
+        detail = "%s: %.3f..%.3f over %d runs%s; bytes per frame %s (every frame a whole cycle)" % (
             how, min(vals), max(vals), len(vals),
             "; at 1 kHz A->B %s, B->A %s" % (
                 next((r.get(key) for r in at1k if r.get("direction") == "a2b"), "-"),
-                next((r.get(key) for r in at1k if r.get("direction") == "b2a"), "-")) if at1k else "")
+                next((r.get(key) for r in at1k if r.get("direction") == "b2a"), "-")) if at1k else "",
+            ", ".join(str(x) for x in sizes) or "-")
         out.append(_check("setup-simulation %s mode: 36 + 9 doubles as one frame per direction per cycle" % mode,
                           ok, detail, "periodic" if (not ok and mode == "periodic") else None))
     # 4. 10 kHz without loss: nothing lost by ccomm, and every cycle seen by the application.
@@ -214,7 +228,7 @@ def checks(R, meta):
         ok = None if x is None else x <= TARGETS["ontarget_ratio"]
         detail = "n/a" if x is None else "`%s` p50 %s µs vs `%s` %s µs = %.2fx%s" % (
             cname, us(c["p50_ns"]), fname, us(f["p50_ns"]), x,
-            "" if ok else " (over by %.0f%%)" % ((x / TARGETS["ontarget_ratio"] - 1) * 100))
+            "" if ok else " (over by %.1f%%)" % ((x / TARGETS["ontarget_ratio"] - 1) * 100))
         style = "spin" if "_spin_" in cname else "block"
         kind = "event" if "_event_" in cname else "state"
         out.append(_check("on-target, %s signal, %s receive: ccomm p50 within 2x of the shared-memory floor"
@@ -251,11 +265,12 @@ def _thesis_tables(R):
                     lines.append(["%g" % r["rate_hz"], r["count"], usr(r, "min_ns"), "**%s**" % usr(r, "p50_ns"),
                                   usr(r, "p99_ns"), usr(r, "p999_ns"), usr(r, "max_ns"), r["lost"],
                                   "%d / %d" % (w.get("frames_lost", 0), r.get("wire_signals_lost", 0)),
-                                  _num(r.get("frames_per_cycle")), _num(r.get("packets_per_cycle")),
+                                  _num(r.get("frames_per_cycle") if mode == "event" else r.get("packets_per_cycle")),
+                                  _num(r.get("tx_wakeups_per_cycle")),
                                   "%d" % ref[0] if ref else "-", "%d" % ref[1] if ref else "-"])
                 out.append(_table(["Hz", "n", "min µs", "p50 µs", "p99 † µs", "p99.9 † µs", "max † µs",
-                                   "app missed", "wire lost (frames / values)", "frames / cycle (run)",
-                                   "packets / cycle (steady)", "thesis min µs", "thesis max µs"], lines))
+                                   "app missed", "wire lost (frames / values)", "frames / cycle",
+                                   "send wake-ups / cycle", "thesis min µs", "thesis max µs"], lines))
                 out.append("")
     return "\n".join(out)
 
@@ -376,45 +391,51 @@ def _cost_tables(R, meta):
 def _why(R, meta, check):
     """Explanation of a missed target from the run's own numbers."""
     if check["why"] == "b2b":
-        c = R.get("ccomm_raw_oneway_block_1khz_p8")
-        s = R.get("ccomm_raw_oneway_spin_1khz_p8")
-        f = R.get("net_raw_oneway_1khz_p8")
-        fx = R.get("shm_futex_1khz_p8")
+        c, f = (R.get(n) for n in check["rows"])
         if not (c and f):
             return ""
-        t = ["The floor has one thread hand-off (the kernel wakes the receiving socket's thread). ccomm's "
-             "path has three: the application's `ccomm_flush()` wakes ccommd's send thread (futex doorbell) "
-             "on board A, the packet wakes ccommd's receive thread on board B (as in the floor), and ccommd "
-             "wakes the application's `ccomm_wait()` (futex) on board B. Each board has one CPU here, so the "
-             "two extra hand-offs are context switches on a CPU, not cross-CPU wake-ups. Measured in this run:"]
-        t.append("- ccomm (blocking application) p50 %s µs - floor p50 %s µs = **%s µs** added by ccomm." % (
-            us(c["p50_ns"]), us(f["p50_ns"]), us(c["p50_ns"] - f["p50_ns"])))
+        t = []
+        if not _B2B_INTRO[0]:
+            _B2B_INTRO[0] = True
+            t.append("Why (common to the board-to-board misses): the floor has one thread hand-off (the kernel "
+                     "wakes the receiving socket's thread). ccomm's path has three: the application's "
+                     "`ccomm_flush()` wakes ccommd's send thread (futex doorbell) on board A, the packet wakes "
+                     "ccommd's receive thread on board B (as in the floor), and ccommd wakes the application's "
+                     "`ccomm_wait()` (futex) on board B. Each board has one CPU here, so the two extra hand-offs "
+                     "are context switches on that CPU; ccommd (priority above the application) also finishes "
+                     "its own loop and blocks in `recv` again before the woken application can run. Measured in "
+                     "this run:\n")
+        t.append("- `%s`: p50 %s µs - floor p50 %s µs = **%s µs** added by ccomm." % (
+            c["name"], us(c["p50_ns"]), us(f["p50_ns"]), us(c["p50_ns"] - f["p50_ns"])))
         g = c.get("stages")
         if g:
-            t.append("- Split at the receiving ccommd (`--stages`): application write -> ccommd on board B has "
-                     "the frame p50 %s µs (the floor's whole socket-to-socket path: %s µs, so board A's doorbell "
-                     "wake-up of ccommd's send thread and both daemons' work add about %s µs), then ccommd -> "
-                     "application on board B p50 %s µs (a futex wake-up on the same CPU plus reading the values)."
-                     % (us(g["upstream_p50_ns"]), us(f["p50_ns"]), us(g["upstream_p50_ns"] - f["p50_ns"]),
-                        us(g["last_hop_p50_ns"])))
-        if s:
-            line = ("- The same with the receiving application busy-polling (`%s`, no wake-up of the "
-                    "application; ccommd still blocks in `recv` like the floor): p50 %s µs, %.2fx the floor" % (
+            t.append("  Split at the receiving ccommd (`--stages`): application write -> ccommd on board B has the "
+                     "frame, p50 %s µs (the floor's whole socket-to-socket path: %s µs; difference %s µs: board "
+                     "A's doorbell wake-up of ccommd's send thread, both daemons' work%s), then ccommd -> "
+                     "application on board B, p50 %s µs (the wake-up on the same CPU, reading the values)." % (
+                         us(g["upstream_p50_ns"]), us(f["p50_ns"]), us(g["upstream_p50_ns"] - f["p50_ns"]),
+                         ", the larger frame" if c["payload_bytes"] > 8 else "", us(g["last_hop_p50_ns"])))
+        if c["payload_bytes"] > 8:
+            cl = (meta.get("cost") or {}).get("callgrind_client") or {}
+            pc = {w.split(" (")[0]: x for w, _, x in cl.get("per_call", [])}
+            cg = ((meta.get("cost") or {}).get("callgrind") or {}).get("setup") or {}
+            per = [v.get("ir_per_signal") for v in (cg.get("nodes") or {}).values() if v.get("ir_per_signal")]
+            k = c["payload_bytes"] // 8
+            if pc and per:
+                t.append("  With %d doubles the work grows per signal: the application writes and reads each "
+                         "(%s + %s instructions per signal, callgrind) and each ccommd encodes or decodes each "
+                         "(about %.0f instructions per signal and daemon), about %.0fk instructions per cycle "
+                         "before the system calls; the floor copies %d bytes once." % (
+                             k, pc.get("ccomm_write_double", "?"), pc.get("ccomm_read_double", "?"),
+                             sum(per) / len(per), k * ((pc.get("ccomm_write_double") or 0) +
+                                                       (pc.get("ccomm_read_double") or 0) + sum(per)) / 1000.0,
+                             c["payload_bytes"]))
+        s = R.get("ccomm_raw_oneway_spin_1khz_p8")
+        if s and c["name"] == "ccomm_raw_oneway_block_1khz_p8":
+            line = ("  With the receiving application busy-polling instead (`%s`, no wake-up of the application; "
+                    "ccommd still blocks in `recv` like the floor): p50 %s µs, %.2fx the floor." % (
                         s["name"], us(s["p50_ns"]), s["p50_ns"] / float(f["p50_ns"])))
-            if f["p50_ns"] < s["p50_ns"] < c["p50_ns"]:
-                line += ("; the application's wake-up on board B accounts for about %s of the %s µs"
-                         % (us(c["p50_ns"] - s["p50_ns"]), us(c["p50_ns"] - f["p50_ns"])))
-            t.append(line + ". On a one-CPU board a polling application still waits for ccommd's receive "
-                     "thread (higher priority, same CPU) to finish and block in `recv` again.")
-        if fx:
-            t.append("- For scale: one futex wake-up between two CPUs on this machine (`shm_futex_1khz_p8`, "
-                     "RTT/2) is %s µs at p50." % us(fx["p50_ns"]))
-        cg = ((meta.get("cost") or {}).get("callgrind") or {}).get("single")
-        if cg:
-            per = ["%s %s" % (n, v["ir_per_signal"]) for n, v in cg["nodes"].items()]
-            t.append("- ccommd's own user-space work per forwarded single signal (callgrind, one signal per "
-                     "frame, instructions): %s: well under a microsecond at this CPU's clock; the added time "
-                     "is the extra wake-ups and system calls, not ccomm's code (see Cost)." % ", ".join(per))
+            t.append(line)
         return "\n".join(t)
     if check["why"] == "ontarget":
         c = R.get("ccomm_shm_state_spin_1khz_p8")
@@ -447,18 +468,27 @@ def _why(R, meta, check):
         return "\n\n".join(t)
     if check["why"] == "periodic":
         at = [r for r in R.where(section="thesis", mode="periodic") if r.get("packets_per_cycle") is not None]
-        ex = ", ".join("`%s` %s" % (r["name"], r["packets_per_cycle"]) for r in at if r["rate_hz"] in (100, 1000))
-        return ("In periodic mode ccommd sends every periodic signal's last value at its rate; in addition the "
-                "application's `ccomm_flush()` (batch mode) rings the send doorbell and ccommd's send loop "
-                "sends every signal marked dirty at once, periodic or not. So each cycle goes out twice: once "
-                "when the application flushes, once at the period (packets per cycle: %s). The receiving "
-                "ccommd drops the second copy (same value sequence number), so the application sees no "
-                "difference in latency, but frames and daemon CPU double; at 10 kHz that saturates the "
-                "one-CPU boards (see the wire-lost and app-missed columns of the periodic 10 kHz rows). This "
-                "is daemon/library behaviour (src/daemon/tx_path.cpp: the dirty-bit loop calls "
-                "CollectSignal(id, now, false) for periodic signals too; src/client/client.cpp: ccomm_flush "
-                "rings the doorbell for periodic-only writes), reported to the lead rather than changed here."
-                % (ex or "see the table"))
+        double = [r for r in at if r["packets_per_cycle"] > 1.5]
+        if double:
+            ex = ", ".join("`%s` %s" % (r["name"], r["packets_per_cycle"]) for r in double[:6])
+            return ("In periodic mode ccommd sends every periodic signal's last value at its rate, and here it also "
+                    "sent the new values at once when the application flushed: each cycle went out twice "
+                    "(packets per cycle: %s). The receiving ccommd drops the second copy (same value sequence "
+                    "number), but frames and daemon CPU double." % ex)
+        slow = [r for r in at if r["packets_per_cycle"] < 0.98]
+        if not slow:
+            return ""
+        r = max(slow, key=lambda x: x["rate_hz"])
+        cpu = r.get("cpu") or {}
+        nodes = [k for k in cpu if k != "wall_s"]
+        pct = ", ".join("%s %.0f%%" % (n, 100.0 * cpu[n]["cpu_ms_sched"] / 1000.0 / cpu["wall_s"]) for n in nodes)
+        return ("At %g Hz ccommd's periodic schedule slipped: %s packets per cycle (`%s`). Periodic sending "
+                "never bursts to catch up (a late period is re-based on the current time), so a slipped period "
+                "means the value of that cycle was replaced by the next one before it left: by design for "
+                "last-value signals, but it shows up as cycles the receiving application never saw. ccommd's "
+                "CPU in that run: %s of a CPU (mostly system time in the veth send/receive path), on one CPU "
+                "per board that also runs the application." % (r["rate_hz"], r["packets_per_cycle"], r["name"],
+                                                                pct or "-"))
     if check["why"] == "loss":
         rows = [r for r in R.where(section="thesis", mode="event") if r["rate_hz"] == 10000 and r.get("cpu")]
         extra = ""
@@ -468,11 +498,13 @@ def _why(R, meta, check):
             pct = ["%s %.0f%% (%.0f%% in the kernel)" % (
                 n, 100.0 * r["cpu"][n]["cpu_ms_sched"] / 1000.0 / r["cpu"]["wall_s"],
                 100.0 * r["cpu"][n].get("system_ms", 0) / 1000.0 / r["cpu"]["wall_s"]) for n in nodes]
-            above = _frac_above(r, 100000)
-            extra = (" In `%s` the receiving application's one-way p50 is %s µs and %s of its samples exceed "
-                     "the 100 µs period; each board's single CPU is also busy with its ccommd (%s of a CPU: "
-                     "the sends and receives are system calls into the veth path)." % (
-                         r["name"], us(r["p50_ns"]), above, ", ".join(pct)))
+            extra = (" In `%s` the application missed %d of %s cycles (%.1f%%): those are the wake-ups that came "
+                     "after the next cycle had already arrived, so their latencies are not among the samples "
+                     "(observed p50 %s µs, p99 %s µs). Each board's single CPU is also busy with its ccommd (%s "
+                     "of a CPU: the sends and receives are system calls into the veth path). The busy-polling "
+                     "rows (section 3) show how much of this is the blocking wake-up." % (
+                         r["name"], r["lost"], r.get("sent"), 100.0 * r["lost"] / max(1, r.get("sent") or 1),
+                         us(r["p50_ns"]), us(r["p99_ns"]), ", ".join(pct)))
         return ("At 10 kHz a cycle is 100 µs; \"app missed\" counts cycles whose values the receiving "
                 "application never saw because the next cycle's values overwrote them first (state signals "
                 "keep the last value) - a late wake-up of the receiver, not a lost frame; \"wire lost\" "
@@ -495,6 +527,7 @@ def _frac_above(r, ns):
 
 
 _OUTDIR = [None]
+_B2B_INTRO = [False]
 
 
 def _machine(meta):
@@ -606,6 +639,7 @@ node names, addresses and CPUs as parameters.
 
 def render(rows, meta, problems, doc_dir, pngs, outdir=None):
     _OUTDIR[0] = outdir
+    _B2B_INTRO[0] = False
     R = Rows(rows)
     cks = checks(R, meta)
     smoke = meta.get("smoke")
@@ -639,11 +673,18 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
         for c in missed:
             if c["why"] in done:
                 continue
-            done.add(c["why"])
+            if c["why"] != "b2b":  # each board-to-board miss has its own numbers
+                done.add(c["why"])
             L.append("**%s** — %s\n" % (c["text"], c["detail"]))
             w = _why(R, meta, c)
             if w:
                 L.append(w + "\n")
+    retried = [r for r in rows if r.get("retried")]
+    if retried:
+        L.append("### Measurements that needed a second try\n")
+        L.append(_table(["case", "first try"], [["`%s`" % r["name"], r["retried"]] for r in retried],
+                        ["l", "l"]))
+        L.append("")
     if problems:
         L.append("### Cases that did not run\n")
         L.append(_table(["case", "status", "reason"], [[p["name"], p["status"], p["reason"]] for p in problems],
@@ -730,13 +771,19 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
                  "B->A). Event-driven: ccommd sends when the application flushes; periodic: every signal has "
                  "`rate_hz` = the send rate. \"app missed\": cycles the receiving application never saw "
                  "complete; \"wire lost\": frames missing in ccommd's sequence numbers / values ccommd counted "
-                 "as lost. The thesis' figures were measured on different hardware over a real switch: compare "
-                 "shape (how latency grows with the rate), not absolute values. Two things to know when reading "
-                 "the rows: in periodic mode every cycle is also sent at once when the application flushes (see "
-                 "Targets), so its latency columns show that immediate copy, not a wait for the period; and at "
-                 "low rates the CPUs idle between cycles, so each wake-up starts from an idle (on this virtual "
-                 "machine: halted) CPU, which is why p50 falls as the rate rises (compare `shm_futex_b2b_p8` "
-                 "with `shm_futex_1khz_p8` in section 1 for the same effect on a bare futex).\n")
+                 "as lost. \"frames / cycle\": event-driven, the sending ccommd's frames_tx minus heartbeats "
+                 "over the cycles sent (whole run); periodic, packets on eth0 per cycle in the steady part of the "
+                 "run. \"send wake-ups / cycle\": ccommd's send thread wake-ups (`tx_wakeups`) per cycle. The "
+                 "thesis' figures were measured on different hardware over a real switch: compare shape (how "
+                 "latency grows with the rate), not absolute values.\n\n"
+                 "Reading the rows: in periodic mode a value waits for ccommd's next period tick. The application "
+                 "and ccommd run at the same rate from unsynchronised starts, so within a run the phase between "
+                 "them, and with it the latency, is nearly constant (p50 close to p99), and between runs it is "
+                 "anywhere from the event-driven latency up to one period: the thesis' polling design had the "
+                 "same property, twice (its server polled too). Event-driven rows have no such wait; their p50 "
+                 "falls as the rate rises because at low rates the CPUs idle between cycles and each wake-up "
+                 "starts from an idle (on this virtual machine: halted) CPU (compare `shm_futex_b2b_p8` with "
+                 "`shm_futex_1khz_p8` in section 1 for the same effect on a bare futex).\n")
         L.append(_thesis_tables(R))
         L.append(_spin_table(R))
         fs = []

@@ -118,7 +118,7 @@ class ReportTest(unittest.TestCase):
         self.assertIn("1.20x", text)
         text, checks = report.render(self.rows(14000, 10000), meta, [], "/tmp", [])
         self.assertEqual(self.status(checks, "board->board raw one-way, 8 B"), "MISSED")
-        self.assertIn("over by 8%", text)
+        self.assertIn("over by 7.7%", text)
         self.assertNotIn(REPO + os.sep, text)
 
 

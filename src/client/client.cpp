@@ -214,7 +214,8 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
   }
   stats.writes.fetch_add(1, std::memory_order_relaxed);
   const bool ring = !(c->flags & (CCOMM_OPEN_NO_DOORBELL | CCOMM_OPEN_BATCH));
-  if (d.flags & st::kSigForwarded) {
+  // Periodic signals leave on ccommd's period: no dirty bit, no doorbell for them.
+  if ((d.flags & st::kSigForwarded) && !(d.flags & st::kSigPeriodic)) {
     if (c->flags & CCOMM_OPEN_BATCH) {
       c->segment.MarkDirty(id);
       c->pending_tx = true;

@@ -780,7 +780,10 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
                  "and ccommd run at the same rate from unsynchronised starts, so within a run the phase between "
                  "them, and with it the latency, is nearly constant (p50 close to p99), and between runs it is "
                  "anywhere from the event-driven latency up to one period: the thesis' polling design had the "
-                 "same property, twice (its server polled too). Event-driven rows have no such wait; their p50 "
+                 "same property, twice (its server polled too). When the write and the tick fall close "
+                 "together, jitter moves some writes across the tick: one period then carries two cycles (the "
+                 "older value is replaced and counts as \"app missed\") and the next none. Event-driven rows "
+                 "have no such wait; their p50 "
                  "falls as the rate rises because at low rates the CPUs idle between cycles and each wake-up "
                  "starts from an idle (on this virtual machine: halted) CPU (compare `shm_futex_b2b_p8` with "
                  "`shm_futex_1khz_p8` in section 1 for the same effect on a bare futex).\n")

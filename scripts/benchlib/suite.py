@@ -353,14 +353,22 @@ def _snapshot(d, names):
 class LinkProbe:
     """Packets each namespace's eth0 sent between two instants while the apps run:
     frames per cycle in steady state (periodic frames go on after the apps stop, so
-    whole-run counters cannot tell)."""
+    whole-run counters cannot tell). pids: a process in namespace a and one in b."""
 
-    def __init__(self, ns):
-        self.ns = ns
+    def __init__(self, pids):
+        self.pids = pids
         self.marks = []
 
     def mark(self):
-        self.marks.append((time.monotonic(), ccomm.link_stats(self.ns.ns_a), ccomm.link_stats(self.ns.ns_b)))
+        # Timestamp and counters belong together: retry if this (SCHED_OTHER) script was
+        # descheduled while reading them.
+        for _ in range(10):
+            t0 = time.monotonic()
+            a, b = ccomm.link_stats(self.pids[0]), ccomm.link_stats(self.pids[1])
+            t1 = time.monotonic()
+            if t1 - t0 < 0.001:
+                break
+        self.marks.append(((t0 + t1) / 2, a, b))
 
     def per_cycle(self, side, rate):
         if len(self.marks) < 2:
@@ -434,12 +442,12 @@ def run_thesis(ctx, case):
         a2b, b2a = ["value"], []
     dur = case.seconds + warm
     periodic = rate if mode == "periodic" else 0
-    ns = ctx.netns()
     with _pair(ctx, case, a2b, b2a, "raw", periodic, names) as d:
         sa = os.path.join(ctx.workdir, case.name + ".a.samples")
         sb = os.path.join(ctx.workdir, case.name + ".b.samples")
         before = _snapshot(d, names)
-        link0 = ccomm.link_stats(ns.ns_a), ccomm.link_stats(ns.ns_b)
+        pids = (d.pid(names[0]), d.pid(names[1]))  # ccommd of board A, of board B
+        link0 = ccomm.link_stats(pids[0]), ccomm.link_stats(pids[1])
         meter = ccomm.CpuMeter(d)
         meter.start()
         lead = SPIN_LEAD if spin else 0.3
@@ -453,15 +461,15 @@ def run_thesis(ctx, case):
             apps = [("b", _app(ctx, d, "b", names[1], rate, dur + 2 * lead, case.name, sb, spin=spin, warmup=warm),
                      0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name + "-src", sa, warmup=warm), lead)]
-        probe = LinkProbe(ns)
+        probe = LinkProbe(pids)
         # Two marks inside the steady part of the run (after the warm-up, before the end);
-        # not with spinning receivers: they starve `ip` (SCHED_OTHER) on both CPUs.
+        # not with spinning receivers, which starve this (SCHED_OTHER) script on both CPUs.
         first = lead if exp == "single" else 0.0
         probes = [] if spin else [(first + warm + 0.05, probe.mark), (first + dur - 0.1, probe.mark)]
         res = ccomm.run_apps(d, apps, dur + 30, probes)
         cpu = meter.stop()
         after = _snapshot(d, names)
-        link1 = ccomm.link_stats(ns.ns_a), ccomm.link_stats(ns.ns_b)
+        link1 = ccomm.link_stats(pids[0]), ccomm.link_stats(pids[1])
     sig = {n: ccomm.signal_totals(before, after, n) for n in names}
     forwarded = sig[names[0]]["rx"] + sig[names[1]]["rx"]  # values stored on the far side
     common = dict(exp=exp, mode=mode, cpu=cpu, forwarded=forwarded, signal_totals=sig,

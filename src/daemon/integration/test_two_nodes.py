@@ -92,9 +92,12 @@ def test_periodic_mode_sends_once_per_period(tmp_path):
         rx = signal_stats(pair.stats("planner"), "wheel2_cur")["rx"] - rx_before
         elapsed = time.time() - t0  # each stats call itself takes ~0.2 s
         # ~200 frames/s (not 1000): never more than one frame per period.
-        assert 150 <= frames <= 200 * elapsed + 5, (frames, elapsed)
-        assert frames - 5 <= rx <= frames + 5, (rx, frames)
-        assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh")
+        assert frames <= 200 * elapsed + 5, (frames, elapsed)
+        assert rx <= frames + 5, (rx, frames)  # at most one new value per frame
+        if not SANITIZED:  # a sanitized writer may not keep up 1 kHz: then fewer new values
+            assert frames >= 150, frames
+            assert frames - 5 <= rx, (rx, frames)
+            assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh")
         assert writer.wait(timeout=10) == 0
         time.sleep(0.2)  # the writer stopped; ccommd keeps re-sending 4.5 every 5 ms
         assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "stale")

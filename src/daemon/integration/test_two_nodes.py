@@ -37,9 +37,12 @@ def test_setup_simulation_both_ways(transport):
             # Cycles the app did not see complete: on a loaded 2-core machine a late reader or
             # a late ccommd lets a newer value replace an older one (state semantics); bounded.
             assert r["lost"] <= 0.10 * sent_by_peer, r
-        # On the wire nothing may be lost: a veth pair does not drop frames.
+        # On the wire nothing may be lost: a veth pair does not drop frames. A sanitized
+        # ccommd (5-15x slower) can fall behind and its socket buffer overflow: counted,
+        # bounded.
         for node, peer in (("control", "planner"), ("planner", "control")):
-            assert peer_stats(pair.stats(node), peer)["frames_lost"] == 0
+            lost = peer_stats(pair.stats(node), peer)["frames_lost"]
+            assert lost <= (0.1 * ra["sent"] if SANITIZED else 0), (node, lost)
         assert ra["send_signals"] == 36 and rb["send_signals"] == 9
         st = pair.stats("planner")
         assert signal_stats(st, "wheel0_pos")["rx"] >= (200 if SANITIZED else 1500)

@@ -148,6 +148,18 @@ void Daemon::Supervise(uint64_t now) {
   }
 }
 
+void Daemon::EnterIoThread(const char* name) {
+  const RealtimeConfig& rt = cfg_->nodes[self_].realtime;
+  if (!opt_.no_realtime) {
+    if (rt.priority > 0 && platform::SetFifoPriority(rt.priority) != 0)
+      Log(LogLevel::kWarning, "%s thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE or RLIMIT_RTPRIO); running "
+          "SCHED_OTHER", name, rt.priority);
+    if (rt.cpu >= 0 && platform::PinToCpu(rt.cpu) != 0)
+      Log(LogLevel::kWarning, "%s thread: cannot pin to CPU %d", name, rt.cpu);
+  }
+  platform::PrefaultStack(32 * 1024);
+}
+
 void Daemon::RequestStop() {
   running_.store(false);
   if (segment_.is_open()) {

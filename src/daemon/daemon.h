@@ -76,6 +76,8 @@ class Daemon {
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now);
+  /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
+  void EnterIoThread(const char* name);
   void Count(store::DaemonCounter c) {
     segment_.header()->daemon_counters[c].fetch_add(1, std::memory_order_relaxed);
   }

@@ -122,14 +122,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
 }
 
 void Daemon::RunRx() {
-  const NodeConfig& self = cfg_->nodes[self_];
-  if (!opt_.no_realtime) {
-    if (self.realtime.priority > 0 && platform::SetFifoPriority(self.realtime.priority) != 0)
-      Log(LogLevel::kWarning, "receive thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE); running SCHED_OTHER",
-          self.realtime.priority);
-    if (self.realtime.cpu >= 0) platform::PinToCpu(self.realtime.cpu);
-  }
-  platform::PrefaultStack(32 * 1024);
+  EnterIoThread("receive");
   while (running_.load(std::memory_order_relaxed)) {
     rx_loops_.fetch_add(1, std::memory_order_relaxed);
     if (!transport_.ops) {  // local-only node: nothing to receive

@@ -88,13 +88,7 @@ constexpr uint64_t kMaxSleepNs = 100ull * 1000 * 1000;
 
 void Daemon::RunTx() {
   const NodeConfig& self = cfg_->nodes[self_];
-  if (!opt_.no_realtime) {
-    if (self.realtime.priority > 0 && platform::SetFifoPriority(self.realtime.priority) != 0)
-      Log(LogLevel::kWarning, "send thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE); running SCHED_OTHER",
-          self.realtime.priority);
-    if (self.realtime.cpu >= 0) platform::PinToCpu(self.realtime.cpu);
-  }
-  platform::PrefaultStack(32 * 1024);
+  EnterIoThread("send");
   store::SegmentHeader* h = segment_.header();
   std::atomic<uint64_t>* dirty = segment_.dirty_words();
   const uint32_t words = (segment_.signal_count() + 63) / 64;

@@ -52,7 +52,9 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
   const st::SegmentHeader* h = s.header();
   double secs = before ? static_cast<double>(now.t - before->t) / 1e9 : 0;
   uint64_t mono = now.t;
-  bool daemon = h->daemon_pid.load() != 0 && mono - h->daemon_heartbeat_ns.load() < 1000000000ull;
+  // The heartbeat may be newer than `mono` (taken before): that is alive, not 2^64 ns old.
+  const uint64_t hb = h->daemon_heartbeat_ns.load();
+  bool daemon = h->daemon_pid.load() != 0 && (hb >= mono || mono - hb < 1000000000ull);
   if (json) {
     printf("{\"node\":\"%s\",\"daemon_alive\":%s,\"generation\":%u,\"counters\":{", h->node_name,
            daemon ? "true" : "false", h->generation.load());

@@ -46,6 +46,9 @@ Snapshot Take(const st::Segment& s) {
   return n;
 }
 
+// Age of a timestamp taken by ccommd after our snapshot time: 0, not 2^64 ns.
+uint64_t Age(uint64_t now, uint64_t t) { return t >= now ? 0 : now - t; }
+
 double Rate(uint64_t a, uint64_t b, double secs) { return secs > 0 ? static_cast<double>(b - a) / secs : 0; }
 
 void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bool json) {
@@ -71,7 +74,7 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
              ",\"down_transitions\":%" PRIu64 ",\"last_rx_age_ms\":%.1f}",
              first ? "" : ",", s.node_name(p), ps.alive.load() ? "true" : "false", ps.frames_rx.load(),
              ps.frames_tx.load(), ps.frames_lost.load(), ps.frames_reordered.load(), ps.heartbeats_rx.load(),
-             ps.down_transitions.load(), last ? static_cast<double>(mono - last) / 1e6 : -1.0);
+             ps.down_transitions.load(), last ? static_cast<double>(Age(mono, last)) / 1e6 : -1.0);
       first = false;
     }
     printf("],\"signals\":[");
@@ -80,7 +83,7 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
       const st::SignalDirectoryEntry& d = s.dir(i);
       uint64_t last = ss.last_rx_ns.load();
       bool stale = (d.flags & st::kSigConsumedHere) && d.stale_after_ms &&
-                   (!last || mono - last > uint64_t{d.stale_after_ms} * 1000000);
+                   (!last || Age(mono, last) > uint64_t{d.stale_after_ms} * 1000000);
       printf("%s{\"name\":\"%s\",\"writes\":%" PRIu64 ",\"write_errors\":%" PRIu64 ",\"tx\":%" PRIu64
              ",\"rx\":%" PRIu64 ",\"lost\":%" PRIu64 ",\"coalesced\":%" PRIu64 ",\"overflow\":%" PRIu64 ",\"stale_transitions\":%" PRIu64
              ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
@@ -110,7 +113,7 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
     printf("%-12s %-5s %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %9" PRIu64 " %10" PRIu64 " %12.1f %8.0f\n",
            s.node_name(p), ps.alive.load() ? "yes" : "NO", ps.frames_rx.load(), ps.frames_tx.load(),
            ps.frames_lost.load(), ps.frames_reordered.load(), ps.heartbeats_rx.load(),
-           last ? static_cast<double>(mono - last) / 1e6 : -1.0,
+           last ? static_cast<double>(Age(mono, last)) / 1e6 : -1.0,
            before ? Rate(before->peer_rx[p], now.peer_rx[p], secs) : 0.0);
   }
   printf("\n%-24s %10s %10s %10s %8s %8s %6s %6s %8s %8s\n", "SIGNAL", "WRITES", "TX", "RX", "LOST", "OVERFLOW",
@@ -121,7 +124,7 @@ void Print(const st::Segment& s, const Snapshot* before, const Snapshot& now, bo
     uint64_t last = ss.last_rx_ns.load();
     const char* stale = "-";
     if ((d.flags & st::kSigConsumedHere) && d.stale_after_ms)
-      stale = (!last || mono - last > uint64_t{d.stale_after_ms} * 1000000) ? "yes" : "no";
+      stale = (!last || Age(mono, last) > uint64_t{d.stale_after_ms} * 1000000) ? "yes" : "no";
     printf("%-24s %10" PRIu64 " %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %8" PRIu64 " %6s %6" PRIu64
            " %8.0f %8.0f\n",
            d.name, ss.writes.load(), ss.tx.load(), ss.rx.load(), ss.lost.load(), ss.overflow.load(), stale,

@@ -19,7 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kSourceDir = CCOMM_SOURCE_DIR;
+// $CCOMM_SOURCE_DIR first: on a target (ptest) the test data is installed elsewhere.
+const std::string kSourceDir = getenv("CCOMM_SOURCE_DIR") ? getenv("CCOMM_SOURCE_DIR") : CCOMM_SOURCE_DIR;
 
 std::string ReadFile(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

@@ -151,7 +151,9 @@ std::string Attr(const std::string& line, const std::string& key) {
 
 // Parses every "```hex name=N expect=E" fenced block; '#' starts a comment.
 std::map<std::string, DocVector> ReadDocVectors() {
-  const std::string path = std::string(CCOMM_SOURCE_DIR) + "/docs/protocol.md";
+  // $CCOMM_SOURCE_DIR first: on a target (ptest) the document is installed elsewhere.
+  const char* dir = getenv("CCOMM_SOURCE_DIR") ? getenv("CCOMM_SOURCE_DIR") : CCOMM_SOURCE_DIR;
+  const std::string path = std::string(dir) + "/docs/protocol.md";
   std::ifstream in(path);
   EXPECT_TRUE(in.good()) << "cannot read " << path;
   std::map<std::string, DocVector> out;

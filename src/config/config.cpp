@@ -605,6 +605,8 @@ class Parser {
   bool Unsigned(const Element& e, const char* attr, uint64_t lo, uint64_t hi, T* out,
                 bool hex = false);
   bool Signed(const Element& e, const char* attr, int64_t lo, int64_t hi, int* out);
+  /// Reports a number that did not parse or is outside `range`; true if it is fine.
+  bool NumberOk(const AttrValue& a, const char* attr, NumResult r, bool in_range, const std::string& range);
   bool Bool(const Element& e, const char* attr, bool* out);
   void Err(int line, std::string msg) { diag_.Error(line, std::move(msg)); }
 
@@ -649,6 +651,19 @@ bool Parser::Name(const Element& e, const char* what, std::string* out) {
   return true;
 }
 
+bool Parser::NumberOk(const AttrValue& a, const char* attr, NumResult r, bool in_range,
+                      const std::string& range) {
+  if (r == NumResult::kSyntax) {
+    Err(a.line, "invalid " + std::string(attr) + " " + Quote(a.value) + " (expected an integer " + range + ")");
+    return false;
+  }
+  if (r == NumResult::kRange || !in_range) {
+    Err(a.line, std::string(attr) + " " + a.value + " out of range (expected " + range + ")");
+    return false;
+  }
+  return true;
+}
+
 template <typename T>
 bool Parser::Unsigned(const Element& e, const char* attr, uint64_t lo, uint64_t hi, T* out,
                       bool hex) {
@@ -666,15 +681,7 @@ bool Parser::Unsigned(const Element& e, const char* attr, uint64_t lo, uint64_t 
   }
   // Hex only where it is the usual notation (EtherType); elsewhere "0x10" is a typo.
   NumResult r = ParseU64(a->value, &v, hex);
-  if (r == NumResult::kSyntax) {
-    Err(a->line, "invalid " + std::string(attr) + " " + Quote(a->value) +
-                     " (expected an integer " + range + ")");
-    return false;
-  }
-  if (r == NumResult::kRange || v < lo || v > hi) {
-    Err(a->line, std::string(attr) + " " + a->value + " out of range (expected " + range + ")");
-    return false;
-  }
+  if (!NumberOk(*a, attr, r, v >= lo && v <= hi, range)) return false;
   *out = static_cast<T>(v);
   return true;
 }
@@ -685,15 +692,7 @@ bool Parser::Signed(const Element& e, const char* attr, int64_t lo, int64_t hi, 
   int64_t v = 0;
   std::string range = std::to_string(lo) + ".." + std::to_string(hi);
   NumResult r = ParseI64(a->value, &v, /*allow_hex=*/false);
-  if (r == NumResult::kSyntax) {
-    Err(a->line, "invalid " + std::string(attr) + " " + Quote(a->value) +
-                     " (expected an integer " + range + ")");
-    return false;
-  }
-  if (r == NumResult::kRange || v < lo || v > hi) {
-    Err(a->line, std::string(attr) + " " + a->value + " out of range (expected " + range + ")");
-    return false;
-  }
+  if (!NumberOk(*a, attr, r, v >= lo && v <= hi, range)) return false;
   *out = static_cast<int>(v);
   return true;
 }

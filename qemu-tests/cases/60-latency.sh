@@ -3,7 +3,9 @@
 # qemu-tests: the thesis latency tables 6.2-6.4 redone between the two boards, 100 Hz to
 # qemu-tests: 1 kHz plus 5 kHz: RTT/2 through ccomm (app -> ccommd -> wire -> ccommd ->
 # qemu-tests: app and back) next to a raw-socket floor measured between the same boards
-# qemu-tests: in the same run, with the ratio. Report: <work>/latency.md and .jsonl.
+# qemu-tests: in the same run, with the ratio, and the cost of one process-to-process
+# qemu-tests: wake-up on a board (futex), which ccomm's path needs four times per round
+# qemu-tests: trip and the floor not at all. Report: <work>/latency.md and .jsonl.
 # qemu-tests: timeout=900
 . "$(dirname "$0")/../lib/common.sh"
 need_ccomm
@@ -18,7 +20,9 @@ OUT=$QT_WORK/latency.jsonl
 
 # The two programs shared with the benchmarks (src/bench, src/tools), as installed.
 NF=$(vm planner 'command -v net_floor || ls /usr/libexec/ccomm/bench/net_floor 2>/dev/null' | head -n1)
+SF=$(vm control 'command -v shm_floor || ls /usr/libexec/ccomm/bench/shm_floor 2>/dev/null' | head -n1)
 check "raw-socket floor program (net_floor) installed" test -n "$NF"
+check "hand-off floor program (shm_floor) installed" test -n "$SF"
 check "ccomm latency program (ccomm-latency) installed" vm control 'command -v ccomm-latency >/dev/null'
 [ -n "$NF" ] || finish
 
@@ -46,6 +50,15 @@ floor_point() { # RATE PAYLOAD EXPERIMENT
 --start-wait-ms 10000 --name floor-$3" 2>&1)
 	vm_bg_stop planner floor >/dev/null
 	record floor "$3" "$r" "$out"
+}
+
+# One process waking another on the same board and back (futex), at the same rate: the
+# price of each hand-off between an application and ccommd on this emulated board.
+handoff_point() { # RATE
+	local r=$1 out
+	out=$(vm --timeout $((SECS + 60)) control "$SF --mode futex --cpu 0,0 --rate $r --count $((r * SECS)) \
+--warmup $((r / 2)) --half --prio $PRIO --name handoff 2>/dev/null")
+	record handoff single "$r" "$out"
 }
 
 ccomm_point() { # RATE EXPERIMENT [SEND RECV on control]
@@ -77,6 +90,7 @@ for r in $RATES; do
 	note "$r Hz ..."
 	floor_point "$r" 8 single
 	ccomm_point "$r" single "$sig_cp" "$sig_pc"
+	if [ "$r" -le 1000 ]; then handoff_point "$r"; fi
 	floor_point "$r" 288 setup
 	ccomm_point "$r" setup
 done

@@ -560,7 +560,7 @@ def _machine(meta):
                                                                meta.get("preempt", "?"),
                                                                meta.get("clocksource", "?"))],
         ["scheduling", "SCHED_FIFO %s for every measured program, ccommd threads %s; RT throttling %s us/s" % (
-            meta.get("prio"), (meta.get("prio") or 70) + 10 if meta.get("prio") else "default",
+            meta.get("prio"), meta.get("daemon_prio") or ((meta.get("prio") or 70) + 10 if meta.get("prio") else "default"),
             meta.get("rt_runtime_us", "?"))],
         ["load average (1/5/15 min)", "start %s, end %s" % (" ".join(meta.get("loadavg_start", [])),
                                                              " ".join(meta.get("loadavg_end", [])))],

@@ -229,14 +229,14 @@ def select(cases, pattern):
 class Bench(floors.Context):
     """floors.Context plus the ccomm programs and the daemon priority."""
 
-    def __init__(self, programs, ccomm_bins, outdir, cpus, prio, prefix, smoke):
+    def __init__(self, programs, ccomm_bins, outdir, cpus, prio, prefix, smoke, daemon_prio=None):
         super().__init__(programs, outdir, cpus=cpus, prio=prio, prefix=prefix)
         self.bins = ccomm_bins
         self.smoke = smoke
         self.workdir = os.path.join(outdir, "ccomm")
         os.makedirs(self.workdir, exist_ok=True)
         # ccommd's threads above the applications, as on a board (<realtime priority=>).
-        self.daemon_prio = min(99, prio + 10) if prio else 80
+        self.daemon_prio = daemon_prio or (min(99, prio + 10) if prio else 80)
         self.no_rt = prio == 0
         self.cost = {}      # extra data for the report (idle, callgrind)
 

@@ -36,11 +36,38 @@ def run(cmd, check=True, **kw):
     return subprocess.run(cmd, check=check, capture_output=True, text=True, **kw)
 
 
+def sweep_stale():
+    """Removes namespaces and segments of earlier runs whose test process is gone (killed
+    before it could clean up): their names carry the creating pid."""
+    try:
+        names = [l.split()[0] for l in run(["ip", "netns", "list"], check=False).stdout.splitlines() if l.strip()]
+    except OSError:
+        return
+    for ns in names:
+        parts = ns.split("-")
+        if len(parts) == 4 and parts[0] == "cci" and parts[1].isdigit() and not os.path.exists("/proc/" + parts[1]):
+            run(["ip", "netns", "del", ns], check=False)
+    for f in os.listdir("/dev/shm"):
+        parts = f.split("-")
+        if len(parts) >= 3 and parts[0] == "cci" and parts[1].isdigit() and not os.path.exists("/proc/" + parts[1]):
+            try:
+                os.unlink("/dev/shm/" + f)
+            except OSError:
+                pass
+
+
+_swept = False
+
+
 class NodePair:
     """control (10.42.0.1) and planner (10.42.0.2) in namespaces <tag>-c / <tag>-p."""
 
     def __init__(self, config=DEFAULT_CONFIG, transport=None, env=None, preload=None):
-        tag = "cci" + uuid.uuid4().hex[:6]
+        global _swept
+        if not _swept:
+            _swept = True
+            sweep_stale()
+        tag = "cci-%d-%s" % (os.getpid(), uuid.uuid4().hex[:6])
         self.ns = {"control": tag + "-c", "planner": tag + "-p"}
         self.config = config
         self.transport = transport
@@ -54,13 +81,17 @@ class NodePair:
 
     def __enter__(self):
         c, p = self.ns["control"], self.ns["planner"]
-        run(["ip", "netns", "add", c])
-        run(["ip", "netns", "add", p])
-        run(["ip", "link", "add", "eth0", "netns", c, "type", "veth", "peer", "name", "eth0", "netns", p])
-        for ns, ip in ((c, "10.42.0.1/24"), (p, "10.42.0.2/24")):
-            run(["ip", "-n", ns, "addr", "add", ip, "dev", "eth0"])
-            run(["ip", "-n", ns, "link", "set", "eth0", "up"])
-            run(["ip", "-n", ns, "link", "set", "lo", "up"])
+        try:
+            run(["ip", "netns", "add", c])
+            run(["ip", "netns", "add", p])
+            run(["ip", "link", "add", "eth0", "netns", c, "type", "veth", "peer", "name", "eth0", "netns", p])
+            for ns, ip in ((c, "10.42.0.1/24"), (p, "10.42.0.2/24")):
+                run(["ip", "-n", ns, "addr", "add", ip, "dev", "eth0"])
+                run(["ip", "-n", ns, "link", "set", "eth0", "up"])
+                run(["ip", "-n", ns, "link", "set", "lo", "up"])
+        except BaseException:
+            self.__exit__(None, None, None)  # a half-made pair leaves nothing behind
+            raise
         return self
 
     def __exit__(self, *exc):

@@ -36,6 +36,21 @@ def _ratio(a, b):
     return a["p50_ns"] / float(b["p50_ns"])
 
 
+def _paired_ratios(a, b):
+    """Ratios of the p50s of repeated halves, alternation by alternation (NAME~1 with
+    NAME~1, ...), or [] when the rows were not measured in alternation."""
+    ra, rb = (a or {}).get("rep_p50_ns") or [], (b or {}).get("rep_p50_ns") or []
+    if len(ra) < 2 or len(ra) != len(rb):
+        return []
+    return [x / float(y) for x, y in zip(ra, rb) if x and y]
+
+
+def _median(v):
+    v = sorted(v)
+    n = len(v)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2.0
+
+
 def usr(r, key):
     """A latency of a row, "-" when nothing was received."""
     return us(r[key]) if r.get("count") else "-"
@@ -141,11 +156,17 @@ def checks(R, meta):
     for t in ("raw", "udp"):
         for p in (8, 288):
             c, f = R.get("ccomm_%s_oneway_block_1khz_p%d" % (t, p)), R.get("net_%s_oneway_1khz_p%d" % (t, p))
-            x = _ratio(c, f)
+            pooled = _ratio(c, f)
+            pairs = _paired_ratios(c, f)
+            # Judged: the median of the alternations' ratios (each ccomm half next to the
+            # floor half measured just before it), robust to a burst of host load.
+            x = _median(pairs) if pairs else pooled
             ok = None if x is None else x <= TARGETS["b2b_raw_ratio"]
             detail = "n/a (row missing)" if x is None else "ccomm p50 %s µs vs floor %s µs = %.2fx%s" % (
-                us(c["p50_ns"]), us(f["p50_ns"]), x,
-                "" if ok else " (over by %.1f%%)" % ((x / TARGETS["b2b_raw_ratio"] - 1) * 100))
+                us(c["p50_ns"]), us(f["p50_ns"]), pooled, "" if not pairs else
+                "; alternation by alternation %s: median **%.2fx**" % (", ".join("%.2f" % r for r in pairs), x))
+            if x is not None and not ok:
+                detail += " (over by %.1f%%)" % ((x / TARGETS["b2b_raw_ratio"] - 1) * 100)
             ck = _check("board->board %s one-way, %d B: ccomm p50 <= 1.3x the %s floor" % (t, p, t), ok,
                         detail, "b2b")
             ck["rows"] = ("ccomm_%s_oneway_block_1khz_p%d" % (t, p), "net_%s_oneway_1khz_p%d" % (t, p))
@@ -742,7 +763,10 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
         L.append("## 2. Board -> board: two namespaces joined by veth\n")
         L.append("app -> ccommd -> wire -> ccommd -> app at 1 kHz, against plain sockets (no daemon) between "
                  "the same namespaces and LCM %s. Ratio: p50 against the floor with the same transport, payload "
-                 "and metric (one-way rows against `net_*_oneway`, RTT/2 rows against `net_*_rtt_half`).\n" %
+                 "and metric (one-way rows against `net_*_oneway`, RTT/2 rows against `net_*_rtt_half`). The one-way "
+                 "blocking rows ran in four alternations, floor then ccomm, each of 1-2 s; the rows pool the "
+                 "samples of all four, and the target table judges the median of the four ratios taken pair by "
+                 "pair, so that a burst of load on the shared host during one alternation does not decide it.\n" %
                  (meta.get("versions") or {}).get("liblcm1", ""))
 
         def bref(r):

@@ -22,7 +22,8 @@ namespace {
 const char* const kCounterNames[] = {"frames_rx",      "frames_tx",       "frames_bad",      "frames_wrong_hash",
                                      "frames_unknown_sender", "frames_auth_failed", "frames_replayed",
                                      "frames_not_for_us", "entries_unknown_signal", "entries_wrong_type",
-                                     "send_errors",    "tx_wakeups",      "recv_errors",     "slots_reclaimed"};
+                                     "send_errors",    "tx_wakeups",      "recv_errors",     "slots_reclaimed",
+                                     "socket_drops"};
 static_assert(sizeof(kCounterNames) / sizeof(kCounterNames[0]) == st::kDaemonCounterCount, "names");
 
 struct Snapshot {

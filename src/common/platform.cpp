@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <linux/futex.h>
+#include <linux/sock_diag.h>
 #include <pthread.h>
 #include <sched.h>
 #include <signal.h>
@@ -11,6 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -111,6 +113,15 @@ int PinToCpu(int cpu) {
   CPU_ZERO(&set);
   CPU_SET(cpu, &set);
   return -pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+}
+
+int SocketDrops(int fd, uint32_t* drops) {
+  uint32_t mem[SK_MEMINFO_VARS] = {};
+  socklen_t len = sizeof mem;
+  if (getsockopt(fd, SOL_SOCKET, SO_MEMINFO, mem, &len) != 0) return -errno;
+  if (len < (SK_MEMINFO_DROPS + 1) * sizeof(uint32_t)) return -EPROTO;
+  *drops = mem[SK_MEMINFO_DROPS];
+  return 0;
 }
 
 void PrefaultStack(size_t bytes) {

@@ -48,6 +48,9 @@ int LockAllMemory();
 int SetFifoPriority(int priority);
 /// Pins the calling thread to `cpu`; 0 or -errno.
 int PinToCpu(int cpu);
+/// Packets the kernel dropped at socket `fd` since it was opened (receive buffer full;
+/// SO_MEMINFO, the `d` that `ss -m` shows). Returns 0 or -errno. Not [rt]: supervision.
+int SocketDrops(int fd, uint32_t* drops);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 

@@ -106,6 +106,8 @@ class Daemon {
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
   std::vector<store::SlotSuspect> reclaim_suspects_;  // slot -> what the last scan saw
   uint64_t next_reclaim_ns_ = 0;
+  uint64_t next_drops_ns_ = 0;
+  uint32_t socket_drops_seen_ = 0;  // the kernel's count for our socket at the last look
   bool wrong_hash_logged_ = false;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
   alignas(8) uint8_t tx_value_[kMaxValueBytes];

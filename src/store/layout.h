@@ -67,8 +67,11 @@ struct alignas(kCacheLine) SegmentHeader {
 enum DaemonCounter : uint32_t {
   kFramesRx = 0, kFramesTx, kFramesBad, kFramesWrongHash, kFramesUnknownSender,
   kFramesAuthFailed, kFramesReplayed, kFramesNotForUs, kEntriesUnknownSignal,
-  kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kSlotsReclaimed, kDaemonCounterCount
+  kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kSlotsReclaimed,
+  kSocketDrops,  // frames the kernel dropped at ccommd's socket (receive buffer full)
+  kDaemonCounterCount
 };
+static_assert(kDaemonCounterCount <= 16, "daemon_counters has 16 entries");
 
 enum SignalFlags : uint32_t {
   kSigEvent = 1u << 0,         // event signal (ring) rather than state (slots)

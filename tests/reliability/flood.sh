@@ -37,8 +37,9 @@ quiet_snapshot() {
 flood_phase() {
   local label=$1; shift
   quiet_snapshot
-  local rx0=$SNAP_RX drops0=$SNAP_DROPS tot0 bad0 lost0 txd0
+  local rx0=$SNAP_RX drops0=$SNAP_DROPS tot0 bad0 lost0 txd0 sdc0
   tot0=$(frames_total planner); bad0=$(counter planner frames_bad); lost0=$(peer planner frames_lost)
+  sdc0=$(counter planner socket_drops)
   txd0=$(tx_dropped control)
   in_ns control "$WORK/flood" "$@" --duration "$SECS" >"$WORK/flood-$label.json" 2>&1 ||
     { not_ok "$label: flooder failed: $(cat "$WORK/flood-$label.json")"; return; }
@@ -55,6 +56,9 @@ flood_phase() {
   check "$label: eth0 rx == counted by ccommd + socket drops ($rx == $tot + $drops)" [ "$rx" -eq $((tot + drops)) ]
   check "$label: junk sent == frames_bad + socket drops + veth drops - genuine lost ($sent == $bad + $drops + $txd - $lost)" \
     [ "$sent" -eq $((bad + drops + txd - lost)) ]
+  # ccommd reads the kernel's count every 100 ms; the 0.4 s pause above covers that.
+  local sdc=$(( $(counter planner socket_drops) - sdc0 ))
+  check "$label: ccommd's socket_drops counter == the kernel's drops at its socket ($sdc == $drops)" [ "$sdc" -eq "$drops" ]
   check "$label: planner ccommd alive" daemon_alive planner
 }
 

@@ -691,9 +691,10 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
              "under the same conditions.\n" % (meta.get("command", "scripts/bench"), meta.get("date", "?"),
                                                meta.get("git_commit", "?")))
     L.append("How to read it: **p50 and ratios are the headline.** Tails (p99, p99.9, max; marked †) "
-             "are reported but flagged: this is a shared 2-CPU virtual machine on which other engineers "
-             "were building during the run (load average at start %s), so tails show the host's and the "
-             "other jobs' scheduling more than ccomm. \"block\" = the receiver sleeps until woken "
+             "are reported but flagged: this is a 2-CPU virtual machine on a shared host (load average "
+             "at start %s; the hypervisor's other guests are not visible in it), so tails show the host's "
+             "scheduling more than ccomm, and even p50s move by 10-30%% between runs: judge ratios "
+             "measured side by side, not absolute numbers. \"block\" = the receiver sleeps until woken "
              "(`ccomm_wait`, futex, eventfd, `recv`, WaitSet); \"spin\" = it busy-polls. ccomm rows are "
              "compared only with floors of the same receive style. One-way rows use the same clock on "
              "both ends (one machine); RTT/2 rows are half a round trip.\n" % (

@@ -433,6 +433,19 @@ static inline void bench_json_str(FILE *f, const char *s)
  * p99/p999/max/mean in ns, count, lost; then metric ("rtt", "rtt_half", "one_way")
  * and whatever the program adds in `extra` (a JSON fragment starting with a comma).
  */
+/* The end of every ping program: halve the round trips if --half, write the raw samples
+ * if --dump, and summarize the measured ones (after the warm-up). */
+static inline bench_stats bench_finish_samples(const bench_opts *o, bench_samples *s, uint64_t total)
+{
+    if (o->half)
+        for (size_t i = 0; i < s->cap; i++)
+            if (s->v[i] != BENCH_MISSING)
+                s->v[i] /= 2;
+    if (o->dump)
+        bench_dump(o->dump, s, (size_t)o->warmup, (size_t)total);
+    return bench_summarize(s, (size_t)o->warmup, (size_t)total);
+}
+
 static inline void bench_print_result(const char *name, const char *transport, const bench_opts *o,
                                       const char *metric, const bench_stats *st, const bench_rt *rt,
                                       const char *extra)

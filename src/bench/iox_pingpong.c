@@ -272,13 +272,7 @@ int main(int argc, char **argv)
         }
         bench_hdr_write(m, BENCH_MSG_FIN, sent, bench_now_ns());
         publish_copy(&n, m, len, BENCH_MSG_FIN);
-        if (o.half)
-            for (size_t i = 0; i < s.cap; i++)
-                if (s.v[i] != BENCH_MISSING)
-                    s.v[i] /= 2;
-        if (o.dump)
-            bench_dump(o.dump, &s, (size_t)o.warmup, (size_t)total);
-        bench_stats st = bench_summarize(&s, (size_t)o.warmup, (size_t)total);
+        bench_stats st = bench_finish_samples(&o, &s, total);
         char extra[256];
         snprintf(extra, sizeof extra,
                  ",\"program\":\"iox_pingpong\",\"wait\":\"%s\",\"sent\":%" PRIu64 ",\"foreign\":%" PRIu64

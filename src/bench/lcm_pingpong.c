@@ -264,13 +264,7 @@ int main(int argc, char **argv)
     bench_hdr_write(m, BENCH_MSG_FIN, sent, bench_now_ns());
     for (int k = 0; k < 3; k++)
         lcm_publish(c.lcm, CH_PING, m, (unsigned)len);
-    if (c.o.half)
-        for (size_t i = 0; i < c.s.cap; i++)
-            if (c.s.v[i] != BENCH_MISSING)
-                c.s.v[i] /= 2;
-    if (c.o.dump)
-        bench_dump(c.o.dump, &c.s, (size_t)c.o.warmup, (size_t)c.total);
-    bench_stats st = bench_summarize(&c.s, (size_t)c.o.warmup, (size_t)c.total);
+    bench_stats st = bench_finish_samples(&c.o, &c.s, c.total);
     char extra[256];
     snprintf(extra, sizeof extra,
              ",\"program\":\"lcm_pingpong\",\"lcm_url\":\"%s\",\"sent\":%" PRIu64 ",\"late\":%" PRIu64

@@ -370,10 +370,9 @@ static size_t wire_bytes(const struct run *r)
 static void print_run(struct run *r, bench_samples *s, bench_rt *rt, const char *metric, uint64_t sent,
                       uint64_t late, uint64_t foreign)
 {
-    uint64_t total = r->o.warmup + r->o.count;
-    if (r->o.dump)
-        bench_dump(r->o.dump, s, (size_t)r->o.warmup, (size_t)total);
-    bench_stats st = bench_summarize(s, (size_t)r->o.warmup, (size_t)total);
+    bench_opts o = r->o;
+    o.half = o.half && strcmp(metric, "one_way") != 0;  /* --half halves round trips only */
+    bench_stats st = bench_finish_samples(&o, s, o.warmup + o.count);
     char extra[512];
     int k = snprintf(extra, sizeof extra,
                      ",\"program\":\"net_floor\",\"role\":\"%s\",\"wire_bytes\":%zu,\"sent\":%" PRIu64
@@ -446,10 +445,6 @@ static int run_ping(struct run *r, bench_rt *rt)
         }
     }
     send_fin(r, sent);
-    if (r->o.half)
-        for (size_t i = 0; i < s.cap; i++)
-            if (s.v[i] != BENCH_MISSING)
-                s.v[i] /= 2;
     print_run(r, &s, rt, r->o.half ? "rtt_half" : "rtt", sent, late, foreign);
     return received ? BENCH_EXIT_OK : BENCH_EXIT_FAIL;
 }

@@ -306,13 +306,7 @@ int main(int argc, char **argv)
     int status = 0;
     waitpid(child, &status, 0);
 
-    if (o.half)
-        for (size_t i = 0; i < s.cap; i++)
-            if (s.v[i] != BENCH_MISSING)
-                s.v[i] /= 2;
-    if (o.dump)
-        bench_dump(o.dump, &s, (size_t)o.warmup, (size_t)total);
-    bench_stats st = bench_summarize(&s, (size_t)o.warmup, (size_t)total);
+    bench_stats st = bench_finish_samples(&o, &s, total);
     char extra[160];
     snprintf(extra, sizeof extra, ",\"program\":\"shm_floor\",\"mode\":\"%s\",\"peer_cpu\":%d,\"same_cpu\":%s",
              mode_names[m], o.cpu[1], same_cpu ? "true" : "false");

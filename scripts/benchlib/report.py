@@ -485,7 +485,11 @@ def _why(R, meta, check):
              "counts the write and marks the cycle for `ccomm_flush()`; the reader's `ccomm_read()` takes "
              "a timestamp for the value's age, copies the newest slot under the seqlock and loads the loss "
              "counter. Several cache lines (cell, slot, statistics) move from the writer's core to the "
-             "reader's, and the reader, polling, keeps pulling them back while the writer writes."]
+             "reader's, and the reader, polling, keeps pulling them back while the writer writes. The floor "
+             "is one line transfer (its RTT/2); any store that publishes a value behind a version word "
+             "needs at least two (the writer takes the line from the polling reader, the reader fetches it "
+             "back), so 2x is the bound of a single-line design, and ccomm's cell, slot and statistics "
+             "lines, taken by the writer and fetched by the reader, make about six."]
         cl = (meta.get("cost") or {}).get("callgrind_client")
         if cl:
             pc = {w.split(" (")[0]: x for w, _, x in cl["per_call"]}

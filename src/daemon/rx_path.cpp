@@ -43,8 +43,6 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
     Count(store::kFramesReplayed);  // an authentic frame seen before (or older than the window)
     return;
   }
-  Count(store::kFramesRx);
-
   store::PeerStats& ps = segment_.peer(h.sender);
   PeerRx& pr = peers_rx_[h.sender];
   uint32_t ahead = h.seq - pr.expected;  // modulo 2^32
@@ -118,6 +116,9 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
     ss.last_rx_ns.store(now, std::memory_order_relaxed);
     stored = true;
   }
+  // Counted last, with release: whoever sees a frame in frames_rx (acquire) also sees
+  // all its entries applied (tests and `ccomm stats` snapshots rely on that).
+  segment_.header()->daemon_counters[store::kFramesRx].fetch_add(1, std::memory_order_release);
   if (stored) segment_.NotifyRx();
 }
 

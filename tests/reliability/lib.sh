@@ -72,6 +72,24 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 1' INT TERM
 
+# Leftovers of an earlier run that was killed outright (SIGKILL: no cleanup ran): its
+# namespaces and segments carry its pid (rel<pid>-*); remove those whose run is gone.
+sweep_stale() {
+  local ns pid
+  for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E '^rel[0-9]+-[a-z]+$'); do
+    pid=${ns#rel}; pid=${pid%%-*}
+    [[ -d /proc/$pid ]] && continue
+    ip netns pids "$ns" 2>/dev/null | xargs -r kill -9 2>/dev/null
+    ip netns del "$ns" 2>/dev/null
+  done
+  for f in /dev/shm/rel[0-9]*.*; do
+    [[ -e $f ]] || continue
+    pid=${f#/dev/shm/rel}; pid=${pid%%.*}
+    [[ $pid =~ ^[0-9]+$ && ! -d /proc/$pid ]] && rm -f "$f"
+  done
+}
+sweep_stale
+
 # spawn LOGFILE NODE command...: runs command in NODE's namespace in the background.
 # `ip netns exec` execs the command, so $! (also kept in PIDS) is the command itself and
 # a signal to it reaches the program, not a wrapper shell.

@@ -16,7 +16,7 @@ import tempfile
 import time
 import unittest
 
-from . import procs, results
+from . import procs, report, results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -99,6 +99,37 @@ class StatsTest(unittest.TestCase):
             rows = results.adopt_rows(results.load_rows(os.path.join(src, "rows.jsonl")), out)
             self.assertEqual(rows[0]["raw"], os.path.join("raw", "ccomm_x.tsv"))
             self.assertEqual(results.load_raw(os.path.join(out, rows[0]["raw"])), [(0, 100), (1, -1)])
+
+
+class PairedRatioTest(unittest.TestCase):
+    """The board-to-board target is judged on the median of the alternations' ratios."""
+
+    def row(self, name, p50s):
+        r = results.row_from_samples(name, "raw", 8, 1000, [sorted(p50s)[len(p50s) // 2]] * 3, 0)
+        r["rep_p50_ns"] = p50s
+        return r
+
+    def test_one_bad_alternation_does_not_decide(self):
+        # Three alternations at 1.1x, one at 3x (a burst of load): pooled p50 would say
+        # 1.4x here; the median of the pairs says 1.1x.
+        c = self.row("ccomm_raw_oneway_block_1khz_p8", [55000, 55000, 55000, 150000])
+        f = self.row("net_raw_oneway_1khz_p8", [50000, 50000, 50000, 50000])
+        c["p50_ns"], f["p50_ns"] = 70000, 50000
+        ck = [k for k in report.checks(report.Rows([c, f]), {})
+              if k["text"].startswith("board->board raw one-way, 8 B")][0]
+        self.assertEqual(ck["status"], "met")
+        self.assertIn("median **1.10x**", ck["detail"])
+
+    def test_all_alternations_over_is_missed(self):
+        c = self.row("ccomm_raw_oneway_block_1khz_p8", [70000, 72000, 68000, 71000])
+        f = self.row("net_raw_oneway_1khz_p8", [50000, 50000, 50000, 50000])
+        ck = [k for k in report.checks(report.Rows([c, f]), {})
+              if k["text"].startswith("board->board raw one-way, 8 B")][0]
+        self.assertEqual(ck["status"], "MISSED")
+
+    def test_unpaired_rows_fall_back_to_pooled(self):
+        self.assertEqual(report._paired_ratios({"rep_p50_ns": [1, 2]}, {"rep_p50_ns": [1]}), [])
+        self.assertEqual(report._median([3.0, 1.0, 2.0, 10.0]), 2.5)
 
 
 class ProgramTest(unittest.TestCase):

@@ -26,8 +26,8 @@ broken_cycle() {
 	note "$what: ccommd --check (exit $rc): $(head -n 3 <<<"$out")"
 	check "$what: ccommd --check rejects it, naming $CFG:$line" \
 		eval "[ $rc != 0 ] && grep -q '$CFG:$line\\b' <<<\"\$out\""
-	# The restart fails in ExecStartPre (ccommd --check); Restart=on-failure retries
-	# every second, and must keep failing.
+	# The restart fails (ccommd exits 1 on a bad file) and, with RestartPreventExitStatus,
+	# the unit stays failed instead of retrying.
 	vm $B 'systemctl restart ccommd' >/dev/null 2>&1
 	check "$what: systemctl restart ccommd fails" eval "! vm $B 'systemctl is-active -q ccommd'"
 	sleep 3

@@ -78,8 +78,8 @@ class Daemon {
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now);
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
-  void Count(store::DaemonCounter c) {
-    segment_.header()->daemon_counters[c].fetch_add(1, std::memory_order_relaxed);
+  void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
+    segment_.header()->daemon_counters[c].fetch_add(1, order);
   }
 
   const SystemConfig* cfg_ = nullptr;

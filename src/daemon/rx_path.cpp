@@ -118,7 +118,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   }
   // Counted last, with release: whoever sees a frame in frames_rx (acquire) also sees
   // all its entries applied (tests and `ccomm stats` snapshots rely on that).
-  segment_.header()->daemon_counters[store::kFramesRx].fetch_add(1, std::memory_order_release);
+  Count(store::kFramesRx, std::memory_order_release);
   if (stored) segment_.NotifyRx();
 }
 

@@ -147,6 +147,29 @@ def test_wait_wakes_on_write(client: Client, node: str) -> None:
     assert client.read("d").value == 42.0
 
 
+def test_wait_sees_a_write_made_before_the_call(client: Client, node: str) -> None:
+    with Client(node) as w:
+        w.write("d", 7.0)
+    assert client.wait(timeout=0) is True  # written after our open, before the call
+    assert client.wait(timeout=0) is False  # reported once
+
+
+def test_cycle_time(client: Client, node: str) -> None:
+    now = Client.now()
+    assert abs(now - time.monotonic_ns()) < 1_000_000_000
+    with Client(node) as w:
+        w.set_time(now - 5_000_000)  # the writer's cycle began 5 ms ago
+        w.write("d", 1.25)
+    r = client.read("d")
+    assert r.source_time_ns == now - 5_000_000 and r.age_ns >= 5_000_000
+    client.set_time(now + 10_000_000_000)  # 10 s later: stale (stale_after_ms = 300)
+    assert client.read("d").status == Status.STALE
+    client.set_time(0)
+    assert client.read("d").status == Status.FRESH
+    with pytest.raises(ccomm.CcommError):
+        client.set_time(-1)
+
+
 def test_wait_times_out(client: Client) -> None:
     t0 = time.monotonic()
     assert client.wait(timeout=0.15) is False

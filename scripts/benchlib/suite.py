@@ -45,7 +45,7 @@ class CCase:
     opts: dict = field(default_factory=dict)
 
     def est_seconds(self):
-        return self.seconds + {"ccomm_local": 1.2, "ccomm_pair": 2.5, "thesis": 2.5,
+        return self.seconds + {"ccomm_local": 1.2, "ccomm_pp": 1.0, "ccomm_pair": 2.5, "thesis": 2.5,
                                "idle": 1.5, "callgrind": 12.0, "callgrind_client": 5.0}.get(self.kind, 1.0)
 
 
@@ -66,10 +66,30 @@ def plan(smoke=False, rates=None, scale=1.0):
 
     cases = []
     # ---- on-target ----
-    for p in (8, 288):
-        cases.append(Case("shm_spin_b2b_p%d" % p, "shm", "ontarget", n(100000, 3000), p, 0, {"mode": "spin"}))
+    # The headline: ccomm's hand-off measured exactly like the busy-read floor (two
+    # processes, back-to-back ping-pong, RTT/2), in four floor/ccomm alternations judged
+    # on the median of the paired ratios (see the board-to-board pairs below). ccomm in
+    # both clock modes: a clock reading in every read and write, or one per loop
+    # iteration (ccomm_set_time, a control loop's usage).
+    reps = (1, 2, 3, 4) if not smoke else (1,)
+    for rep in reps:
+        suffix = "" if smoke else REPEAT % rep
+        cases.append(Case("shm_spin_b2b_p8" + suffix, "shm", "ontarget", n(25000, 3000), 8, 0, {"mode": "spin"}))
+        for kind in ("state", "event"):
+            for clock in ("call", "cycle"):
+                cases.append(CCase("ccomm_pp_%s_spin_%s_b2b_p8%s" % (kind, clock, suffix), "ontarget", "ccomm_pp",
+                                   0.5, {"kind": kind, "payload": 8, "wait": "spin", "clock": clock,
+                                         "count": n(25000, 3000)}))
+    cases.append(Case("shm_spin_b2b_p288", "shm", "ontarget", n(100000, 3000), 288, 0, {"mode": "spin"}))
+    for clock in ("call", "cycle"):
+        cases.append(CCase("ccomm_pp_state_spin_%s_b2b_p288" % clock, "ontarget", "ccomm_pp", 0.5,
+                           {"kind": "state", "payload": 288, "wait": "spin", "clock": clock,
+                            "count": n(50000, 3000)}))
     for p in (8, 288):
         cases.append(Case("shm_futex_b2b_p%d" % p, "shm", "ontarget", n(20000, 500), p, 0, {"mode": "futex"}))
+    for kind in ("state", "event"):
+        cases.append(CCase("ccomm_pp_%s_block_call_b2b_p8" % kind, "ontarget", "ccomm_pp", 1.0,
+                           {"kind": kind, "payload": 8, "wait": "block", "clock": "call", "count": n(20000, 500)}))
     cases.append(Case("shm_eventfd_b2b_p8", "shm", "ontarget", n(20000, 500), 8, 0, {"mode": "eventfd"}))
     cases.append(Case("shm_futex_1khz_p8", "shm", "ontarget", n(3000, 200), 8, 1000, {"mode": "futex"}))
     for p in (8, 72, 288):
@@ -145,7 +165,8 @@ def plan(smoke=False, rates=None, scale=1.0):
 
 # The smoke run: one case of every kind of measurement, so none of them can rot.
 SMOKE_CASES = {
-    "shm_spin_b2b_p8", "shm_futex_b2b_p8", "shm_futex_1khz_p8", "iox_spin_b2b_p8", "iox_waitset_b2b_p8",
+    "shm_spin_b2b_p8", "shm_futex_b2b_p8", "ccomm_pp_state_spin_call_b2b_p8", "ccomm_pp_event_spin_cycle_b2b_p8",
+    "ccomm_pp_state_block_call_b2b_p8", "shm_futex_1khz_p8", "iox_spin_b2b_p8", "iox_waitset_b2b_p8",
     "ccomm_shm_state_spin_1khz_p8", "ccomm_shm_state_block_1khz_p8", "ccomm_shm_event_block_1khz_p8",
     "net_raw_oneway_1khz_p8", "net_udp_oneway_1khz_p8", "net_raw_rtt_half_1khz_p8", "lcm_netns_rtt_half_1khz_p8",
     "ccomm_raw_oneway_block_1khz_p8", "ccomm_udp_oneway_block_1khz_p8", "ccomm_raw_oneway_spin_1khz_p8",
@@ -314,6 +335,34 @@ def run_local(ctx, case):
     row = ccomm.samples_row(case.name, "shm", 8 * len(sigs), o["rate"], res, samples, ctx.rawdir,
                             style=o["style"], signal_kind="event" if o["event"] else "state",
                             signals=len(sigs), command=argv)
+    return [row]
+
+
+def run_pingpong(ctx, case):
+    """ccomm_pingpong: echo and ping processes on CPUs b and a through one node's
+    segment (its ccommd running), back to back, RTT/2 like shm_floor and iox_pingpong."""
+    ctx.need("ccommd", "ccomm_pingpong")
+    o = case.opts
+    ping, pong = ccomm.PINGPONG[(o["kind"], o["payload"])]
+    a = ctx.cpu("a")
+    with Daemons(ctx.bins, ccomm.local_config(ctx.daemon_prio, a), [(ccomm.LOCAL_NODE, None, a)], ctx.workdir,
+                 case.name, no_rt=ctx.no_rt) as d:
+        exe = ["env", "CCOMM_SHM_PREFIX=" + d.prefix, ctx.bins["ccomm_pingpong"], "--node", ccomm.LOCAL_NODE,
+               "--ping", ping, "--pong", pong, "--wait", o["wait"], "--payload", str(o["payload"])]
+        if o["clock"] == "cycle":
+            exe.append("--cycle-time")
+        echo = procs.start_background(exe + ["--role", "echo"] + ctx.side_opts("b"),
+                                      os.path.join(ctx.workdir, case.name + ".echo.log"))
+        try:
+            argv = exe + ["--role", "ping", "--half", "--name", case.name, "--count", str(o["count"]),
+                          "--warmup", "1000", "--dump", os.path.join(ctx.rawdir, case.name + ".tsv")] + \
+                ctx.side_opts("a")
+            row = procs.run_measurement(argv, 60, os.path.join(ctx.workdir, case.name + ".ping.log"))
+        finally:
+            procs.stop(echo)
+            procs.forget(echo)
+    row["raw"] = os.path.relpath(os.path.join(ctx.rawdir, case.name + ".tsv"), ctx.outdir)
+    row.update(style=o["wait"], signal_kind=o["kind"], clock=o["clock"], command=argv)
     return [row]
 
 
@@ -625,5 +674,5 @@ def run_callgrind_client(ctx, case):
     return []
 
 
-RUNNERS = {"ccomm_local": run_local, "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle,
+RUNNERS = {"ccomm_local": run_local, "ccomm_pp": run_pingpong, "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle,
            "callgrind": run_callgrind, "callgrind_client": run_callgrind_client}

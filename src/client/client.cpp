@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // libccomm: the C API (ccomm.h) over the shared-memory store. Reads and writes touch
-// only the mapped segment and the handle's preallocated cursors.
+// only the signal's lines in the mapped segment and the handle's preallocated,
+// per-signal state (HandleSignal).
 #include "ccomm/ccomm.h"
 
 #include <errno.h>
@@ -20,19 +21,99 @@ using ccomm::store::SlotMeta;
 using ccomm::store::StoreResult;
 namespace st = ccomm::store;
 
+// The last copy a handle took of a state signal larger than the inline copy: while
+// `latest` is unchanged a read copies from here, so a handle polling a signal does not
+// pull the writer's slot lines to its CPU (the writer then keeps them in its cache).
+struct StateCache {
+  uint64_t version = 0;  // `latest` of the copy; 0 = none
+  SlotMeta meta;
+  uint8_t* value = nullptr;  // value_bytes; null for small (inline) and event signals
+};
+
+// One signal as a handle sees it, resolved at open: a read or write touches this, the
+// signal's own lines in the segment and nothing else (no directory or header walks).
+struct HandleSignal {
+  uint32_t flags = 0;        // SignalFlags
+  uint32_t value_bytes = 0;
+  uint32_t count = 0;
+  uint8_t type = 0;
+  uint64_t stale_ns = 0;     // 0 = never stale
+  st::SignalStats* stats = nullptr;
+  const uint8_t* safe_value = nullptr;
+  st::StateView state;       // state signals
+  st::RingView ring;         // event signals
+  RingCursor cursor;         // event signals: this handle's position
+  StateCache cache;
+  uint64_t seen = 0;         // change counter at the last ccomm_wait()
+};
+
 struct ccomm_client {
   Segment segment;
   uint32_t flags = 0;
   uint32_t signal_count = 0;
-  RingCursor* cursors = nullptr;  // one per signal (used by event signals only)
-  bool pending_tx = false;        // CCOMM_OPEN_BATCH: forwarded writes since the last flush
-  bool pending_rx = false;        // CCOMM_OPEN_BATCH: any write since the last flush
+  HandleSignal* sig = nullptr;     // signal_count entries
+  uint8_t* cache_bytes = nullptr;  // the caches' values
+  uint64_t cycle_ns = 0;           // ccomm_set_time(): "now" for reads and writes; 0 = clock
+  bool pending_tx = false;         // CCOMM_OPEN_BATCH: forwarded writes since the last flush
+  bool pending_rx = false;         // CCOMM_OPEN_BATCH: any write since the last flush
 };
 
 namespace {
 
-bool ValidSignal(const ccomm_client* c, ccomm_signal s) {
-  return c && s >= 0 && static_cast<uint32_t>(s) < c->signal_count;
+// A signal's change counter: `latest` of a state, `published` of an event ring.
+uint64_t ChangeCounter(const HandleSignal& h) {
+  if (h.flags & st::kSigEvent) return h.ring.ring->published.load(std::memory_order_seq_cst);
+  return h.state.cell->latest.load(std::memory_order_seq_cst);
+}
+
+// Compares every signal's change counter with the last look and remembers the new
+// ones: true if anything was written since. O(signals): ccomm_wait() only.
+bool TakeChanges(ccomm_client* c) {
+  bool changed = false;
+  for (uint32_t i = 0; i < c->signal_count; ++i) {
+    uint64_t v = ChangeCounter(c->sig[i]);
+    if (v != c->sig[i].seen) changed = true;
+    c->sig[i].seen = v;
+  }
+  return changed;
+}
+
+size_t CachedBytes(const SignalDirectoryEntry& d) {
+  return (d.flags & st::kSigEvent) || d.value_bytes <= st::kInlineValueBytes ? 0 : d.value_bytes;
+}
+
+// Reads a state through the handle's cache (see StateCache).
+StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
+  StateCache& k = h.cache;
+  if (!k.value) return st::StateRead(h.state, value, meta);
+  if (k.version && st::StateVersion(h.state) == k.version) {
+    memcpy(value, k.value, h.value_bytes);
+    *meta = k.meta;
+    return StoreResult::kOk;
+  }
+  uint64_t version = 0;
+  StoreResult r = st::StateRead(h.state, value, meta, &version);
+  if (r == StoreResult::kOk) {
+    memcpy(k.value, value, h.value_bytes);
+    k.meta = *meta;
+    k.version = version;
+  }
+  return r;
+}
+
+uint64_t Now(const ccomm_client* c) { return c->cycle_ns ? c->cycle_ns : ccomm::platform::MonotonicNs(); }
+
+// Age of a value stored at `stored_ns` as seen at `now`: 0 if it arrived after `now`
+// (a cycle time taken before it arrived).
+int64_t Age(uint64_t now, uint64_t stored_ns) { return now > stored_ns ? static_cast<int64_t>(now - stored_ns) : 0; }
+
+// The signal `s` of handle `c`, or null for a bad handle or id.
+HandleSignal* Sig(const ccomm_client* c, ccomm_signal s) {
+  return c && s >= 0 && static_cast<uint32_t>(s) < c->signal_count ? &c->sig[s] : nullptr;
+}
+
+bool Retired(const ccomm_client* c) {
+  return c->segment.header()->state.load(std::memory_order_relaxed) == st::kRetired;
 }
 
 int MapError(int neg_errno) {
@@ -73,21 +154,46 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   }
   c->flags = flags;
   c->signal_count = c->segment.signal_count();
-  c->cursors = new (std::nothrow) RingCursor[c->signal_count ? c->signal_count : 1];
-  if (!c->cursors) {
-    delete c;
+  const uint32_t n = c->signal_count;
+  c->sig = new (std::nothrow) HandleSignal[n ? n : 1];
+  size_t cache_total = 0;
+  for (uint32_t i = 0; i < n; ++i) cache_total += CachedBytes(c->segment.dir(i));
+  c->cache_bytes = new (std::nothrow) uint8_t[cache_total ? cache_total : 1];
+  if (!c->sig || !c->cache_bytes) {
+    ccomm_close(c);
     return CCOMM_E_SYS;
   }
-  for (uint32_t i = 0; i < c->signal_count; ++i)
-    if (c->segment.dir(i).flags & st::kSigEvent)
-      ccomm::store::RingSubscribe(c->segment.ring(i), &c->cursors[i]);
+  size_t off = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const SignalDirectoryEntry& d = c->segment.dir(i);
+    HandleSignal& h = c->sig[i];
+    h.flags = d.flags;
+    h.value_bytes = d.value_bytes;
+    h.count = d.count;
+    h.type = d.type;
+    h.stale_ns = uint64_t{d.stale_after_ms} * 1000000;
+    h.stats = &c->segment.stats(i);
+    h.safe_value = c->segment.safe_value(i);
+    if (d.flags & st::kSigEvent) {
+      h.ring = c->segment.ring(i);
+      ccomm::store::RingSubscribe(h.ring, &h.cursor);
+    } else {
+      h.state = c->segment.state(i);
+    }
+    if (size_t k = CachedBytes(d)) {
+      h.cache.value = c->cache_bytes + off;
+      off += k;
+    }
+  }
+  TakeChanges(c);  // ccomm_wait() waits for writes after the open
   *out = c;
   return 0;
 }
 
 void ccomm_close(ccomm_client* c) {
   if (!c) return;
-  delete[] c->cursors;
+  delete[] c->sig;
+  delete[] c->cache_bytes;
   delete c;
 }
 
@@ -121,7 +227,7 @@ int ccomm_signal_count(const ccomm_client* c) { return c ? static_cast<int>(c->s
 const char* ccomm_node_name(const ccomm_client* c) { return c ? c->segment.header()->node_name : nullptr; }
 
 int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
-  if (!ValidSignal(c, s) || !out) return CCOMM_E_INVAL;
+  if (!Sig(c, s) || !out) return CCOMM_E_INVAL;
   const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));
   out->name = d.name;
   out->type = d.type;
@@ -136,25 +242,23 @@ int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out
 }
 
 int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_info* info) {
-  if (!ValidSignal(c, s) || !value) return CCOMM_E_INVAL;
-  const uint32_t id = static_cast<uint32_t>(s);
-  const SignalDirectoryEntry& d = c->segment.dir(id);
-  if (len != d.value_bytes) return CCOMM_E_TYPE;
-  if (c->segment.header()->state.load(std::memory_order_relaxed) == st::kRetired) return CCOMM_E_RETIRED;
+  HandleSignal* h = Sig(c, s);
+  if (!h || !value) return CCOMM_E_INVAL;
+  if (len != h->value_bytes) return CCOMM_E_TYPE;
+  if (Retired(c)) return CCOMM_E_RETIRED;
   SlotMeta meta;
-  const uint64_t now = ccomm::platform::MonotonicNs();
-  st::SignalStats& stats = c->segment.stats(id);
+  const uint64_t now = Now(c);
 
-  if (d.flags & st::kSigEvent) {
-    RingCursor& cur = c->cursors[id];
+  if (h->flags & st::kSigEvent) {
+    RingCursor& cur = h->cursor;
     uint64_t lost_before = cur.lost;
-    StoreResult r = ccomm::store::RingRead(c->segment.ring(id), &cur, value, &meta, now);
-    if (cur.lost != lost_before) stats.overflow.fetch_add(cur.lost - lost_before, std::memory_order_relaxed);
+    StoreResult r = ccomm::store::RingRead(h->ring, &cur, value, &meta, now);
+    if (cur.lost != lost_before) h->stats->overflow.fetch_add(cur.lost - lost_before, std::memory_order_relaxed);
     if (r != StoreResult::kOk) {
       if (info) {
         FillNever(info);
         info->status = CCOMM_EMPTY;
-        info->lost = cur.lost + stats.lost.load(std::memory_order_relaxed);
+        info->lost = cur.lost + h->stats->lost.load(std::memory_order_relaxed);
       }
       return CCOMM_EMPTY;
     }
@@ -162,27 +266,26 @@ int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_i
       info->status = CCOMM_FRESH;
       info->flags = 0;
       info->seq = meta.value_seq;
-      info->age_ns = static_cast<int64_t>(now - meta.local_time_ns);
+      info->age_ns = Age(now, meta.local_time_ns);
       info->source_time_ns = meta.source_time_ns;
-      info->lost = cur.lost + stats.lost.load(std::memory_order_relaxed);
+      info->lost = cur.lost + h->stats->lost.load(std::memory_order_relaxed);
     }
     return CCOMM_FRESH;
   }
 
-  StoreResult r = ccomm::store::StateRead(c->segment.state(id), value, &meta);
+  StoreResult r = ReadState(*h, value, &meta);
   if (r == StoreResult::kBusy) return CCOMM_E_BUSY;
   int status;
   int64_t age = -1;
   if (r == StoreResult::kNever) {
     status = CCOMM_NEVER;
   } else {
-    age = static_cast<int64_t>(now - meta.local_time_ns);
-    status = (d.stale_after_ms && age > static_cast<int64_t>(d.stale_after_ms) * 1000000) ? CCOMM_STALE
-                                                                                       : CCOMM_FRESH;
+    age = Age(now, meta.local_time_ns);
+    status = (h->stale_ns && static_cast<uint64_t>(age) > h->stale_ns) ? CCOMM_STALE : CCOMM_FRESH;
   }
   uint32_t flags = 0;
-  if (status != CCOMM_FRESH && (d.flags & st::kSigHasSafeValue)) {
-    memcpy(value, c->segment.safe_value(id), d.value_bytes);
+  if (status != CCOMM_FRESH && h->safe_value) {
+    memcpy(value, h->safe_value, h->value_bytes);
     flags |= CCOMM_INFO_SAFE_VALUE;
   }
   if (info) {
@@ -191,55 +294,54 @@ int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_i
     info->seq = r == StoreResult::kOk ? meta.value_seq : 0;
     info->age_ns = age;
     info->source_time_ns = r == StoreResult::kOk ? meta.source_time_ns : 0;
-    info->lost = stats.lost.load(std::memory_order_relaxed);
+    info->lost = h->stats->lost.load(std::memory_order_relaxed);
   }
   return status;
 }
 
 int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) {
-  if (!ValidSignal(c, s) || !value) return CCOMM_E_INVAL;
-  const uint32_t id = static_cast<uint32_t>(s);
-  const SignalDirectoryEntry& d = c->segment.dir(id);
-  if (len != d.value_bytes) return CCOMM_E_TYPE;
-  if (!(d.flags & st::kSigProducedHere)) return CCOMM_E_PERM;
-  if (c->segment.header()->state.load(std::memory_order_relaxed) == st::kRetired) return CCOMM_E_RETIRED;
-  const uint64_t now = ccomm::platform::MonotonicNs();
-  StoreResult r = (d.flags & st::kSigEvent)
-                      ? ccomm::store::RingWrite(c->segment.ring(id), value, 0, now, now)
-                      : ccomm::store::StateWrite(c->segment.state(id), value, 0, now, now);
-  st::SignalStats& stats = c->segment.stats(id);
+  HandleSignal* h = Sig(c, s);
+  if (!h || !value) return CCOMM_E_INVAL;
+  if (len != h->value_bytes) return CCOMM_E_TYPE;
+  if (!(h->flags & st::kSigProducedHere)) return CCOMM_E_PERM;
+  if (Retired(c)) return CCOMM_E_RETIRED;
+  const uint64_t now = Now(c);
+  StoreResult r = (h->flags & st::kSigEvent) ? ccomm::store::RingWrite(h->ring, value, 0, now, now)
+                                             : ccomm::store::StateWrite(h->state, value, 0, now, now);
   if (r != StoreResult::kOk) {
-    stats.write_errors.fetch_add(1, std::memory_order_relaxed);
+    h->stats->write_errors.fetch_add(1, std::memory_order_relaxed);
     return r == StoreResult::kFull ? CCOMM_E_FULL : CCOMM_E_BUSY;
   }
-  stats.writes.fetch_add(1, std::memory_order_relaxed);
+  h->stats->writes.fetch_add(1, std::memory_order_relaxed);
   const bool ring = !(c->flags & (CCOMM_OPEN_NO_DOORBELL | CCOMM_OPEN_BATCH));
   // Periodic signals leave on ccommd's period: no dirty bit, no doorbell for them.
-  if ((d.flags & st::kSigForwarded) && !(d.flags & st::kSigPeriodic)) {
+  if ((h->flags & st::kSigForwarded) && !(h->flags & st::kSigPeriodic)) {
+    const uint32_t id = static_cast<uint32_t>(s);
     if (c->flags & CCOMM_OPEN_BATCH) {
       c->segment.MarkDirty(id);
       c->pending_tx = true;
     } else {
-      c->segment.NotifyTx(id, ring && !(d.flags & st::kSigPeriodic));
+      c->segment.NotifyTx(id, ring);
     }
   }
+  // Waiters are woken now (no write to shared lines unless someone waits), at the
+  // flush (batch), or see the change when they next wait or time out (no doorbell).
   if (ring) c->segment.NotifyRx();
   else if (c->flags & CCOMM_OPEN_BATCH) c->pending_rx = true;
-  else c->segment.header()->rx_doorbell.fetch_add(1, std::memory_order_release);
   return 0;
 }
 
 #define CCOMM_TYPED(suffix, ctype, code)                                                     \
   int ccomm_read_##suffix(ccomm_client* c, ccomm_signal s, ctype* v, ccomm_info* info) {     \
-    if (!ValidSignal(c, s) || !v) return CCOMM_E_INVAL;                                      \
-    const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));                 \
-    if (d.type != (code) || d.count != 1) return CCOMM_E_TYPE;                               \
+    const HandleSignal* h = Sig(c, s);                                                       \
+    if (!h || !v) return CCOMM_E_INVAL;                                                      \
+    if (h->type != (code) || h->count != 1) return CCOMM_E_TYPE;                             \
     return ccomm_read(c, s, v, sizeof(ctype), info);                                         \
   }                                                                                          \
   int ccomm_write_##suffix(ccomm_client* c, ccomm_signal s, ctype v) {                       \
-    if (!ValidSignal(c, s)) return CCOMM_E_INVAL;                                            \
-    const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));                 \
-    if (d.type != (code) || d.count != 1) return CCOMM_E_TYPE;                               \
+    const HandleSignal* h = Sig(c, s);                                                       \
+    if (!h) return CCOMM_E_INVAL;                                                            \
+    if (h->type != (code) || h->count != 1) return CCOMM_E_TYPE;                             \
     return ccomm_write(c, s, &v, sizeof(ctype));                                             \
   }
 
@@ -252,9 +354,9 @@ CCOMM_TYPED(int64, int64_t, CCOMM_INT64)
 
 // bool is one byte in the segment and on the wire; the C API uses int for portability.
 int ccomm_read_bool(ccomm_client* c, ccomm_signal s, int* v, ccomm_info* info) {
-  if (!ValidSignal(c, s) || !v) return CCOMM_E_INVAL;
-  const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));
-  if (d.type != CCOMM_BOOL || d.count != 1) return CCOMM_E_TYPE;
+  const HandleSignal* h = Sig(c, s);
+  if (!h || !v) return CCOMM_E_INVAL;
+  if (h->type != CCOMM_BOOL || h->count != 1) return CCOMM_E_TYPE;
   uint8_t b = 0;
   int r = ccomm_read(c, s, &b, 1, info);
   *v = b ? 1 : 0;
@@ -262,9 +364,9 @@ int ccomm_read_bool(ccomm_client* c, ccomm_signal s, int* v, ccomm_info* info) {
 }
 
 int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v) {
-  if (!ValidSignal(c, s)) return CCOMM_E_INVAL;
-  const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));
-  if (d.type != CCOMM_BOOL || d.count != 1) return CCOMM_E_TYPE;
+  const HandleSignal* h = Sig(c, s);
+  if (!h) return CCOMM_E_INVAL;
+  if (h->type != CCOMM_BOOL || h->count != 1) return CCOMM_E_TYPE;
   uint8_t b = v ? 1 : 0;
   return ccomm_write(c, s, &b, 1);
 }
@@ -276,23 +378,43 @@ int ccomm_flush(ccomm_client* c) {
     if (quiet) c->segment.header()->tx_doorbell.fetch_add(1, std::memory_order_release);
     else c->segment.RingTxDoorbell();
   }
-  if (c->pending_rx) {
-    if (quiet) c->segment.header()->rx_doorbell.fetch_add(1, std::memory_order_release);
-    else c->segment.NotifyRx();
-  }
+  if (c->pending_rx && !quiet) c->segment.NotifyRx();
   c->pending_tx = c->pending_rx = false;
   return 0;
 }
 
+int ccomm_set_time(ccomm_client* c, int64_t t_ns) {
+  if (!c || t_ns < 0) return CCOMM_E_INVAL;
+  c->cycle_ns = static_cast<uint64_t>(t_ns);
+  return 0;
+}
+
+int64_t ccomm_now(void) { return static_cast<int64_t>(ccomm::platform::MonotonicNs()); }
+
 int ccomm_wait(ccomm_client* c, int timeout_ms) {
   if (!c) return CCOMM_E_INVAL;
   st::SegmentHeader* h = c->segment.header();
-  uint32_t seen = h->rx_doorbell.load(std::memory_order_seq_cst);
+  // Register first, then look (see SegmentHeader::rx_waiters): a write this look
+  // misses has seen us waiting and bumps the doorbell, so FutexWait returns at once.
   h->rx_waiters.fetch_add(1, std::memory_order_seq_cst);
-  bool woke = ccomm::platform::FutexWait(&h->rx_doorbell, seen,
-                                         timeout_ms < 0 ? -1 : int64_t{timeout_ms} * 1000000);
+  uint32_t seen = h->rx_doorbell.load(std::memory_order_seq_cst);
+  bool changed = TakeChanges(c);
+  const uint64_t deadline = ccomm::platform::MonotonicNs() + uint64_t(timeout_ms < 0 ? 0 : timeout_ms) * 1000000;
+  // Bounded by the deadline; a wake-up for a change another waiter consumed, or a
+  // signal, sleeps again.
+  while (!changed) {
+    int64_t left = -1;
+    if (timeout_ms >= 0) {
+      uint64_t now = ccomm::platform::MonotonicNs();
+      if (now >= deadline) break;
+      left = static_cast<int64_t>(deadline - now);
+    }
+    ccomm::platform::FutexWait(&h->rx_doorbell, seen, left);
+    seen = h->rx_doorbell.load(std::memory_order_seq_cst);
+    changed = TakeChanges(c);
+  }
   h->rx_waiters.fetch_sub(1, std::memory_order_seq_cst);
-  return (woke || h->rx_doorbell.load(std::memory_order_acquire) != seen) ? 1 : 0;
+  return changed ? 1 : 0;
 }
 
 int ccomm_daemon_alive(const ccomm_client* c) {

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 
 #include <array>
+#include <atomic>
+#include <vector>
 #include <thread>
 
 #include "store/segment.h"
@@ -179,6 +181,89 @@ TEST_F(ClientTest, WaitWakesOnWriteAndTimesOut) {
   });
   EXPECT_TRUE(r.wait(5000));
   t.join();
+}
+
+// A write that lands between a consumer's reads and its next ccomm_wait() is not
+// missed (the wait returns at once), for states and events, with and without the
+// doorbell; a wait reports each change once.
+TEST_F(ClientTest, WaitNeverMissesAWriteBeforeTheCall) {
+  for (uint32_t flags : {0u, unsigned{CCOMM_OPEN_NO_DOORBELL}}) {
+    ccomm_client* w = nullptr;
+    ASSERT_EQ(ccomm_open("a", flags, &w), 0);
+    ccomm::Client r("a");
+    ccomm_signal local = ccomm_find(w, "local"), ev = ccomm_find(w, "estop");
+    EXPECT_FALSE(r.wait(0));  // nothing since the open
+    ASSERT_EQ(ccomm_write_float(w, local, 2.0f), 0);
+    EXPECT_TRUE(r.wait(0));
+    EXPECT_FALSE(r.wait(0));  // already reported
+    ASSERT_EQ(ccomm_write_bool(w, ev, 1), 0);
+    EXPECT_TRUE(r.wait(1000));
+    EXPECT_FALSE(r.wait(5));
+    ccomm_close(w);
+  }
+}
+
+// Three waiters and a writer: each waiter reads after every wake-up and must see the
+// last value without ever timing out (a lost wake-up would leave it asleep).
+TEST_F(ClientTest, WaitersSeeEveryWriteWithoutTimingOut) {
+  ccomm::Client w("a");
+  auto s = w.signal<float>("local");
+  std::atomic<int> ready{0}, timeouts{0}, done{0};
+  std::vector<std::thread> th;
+  for (int k = 0; k < 3; ++k) {
+    th.emplace_back([&] {
+      ccomm::Client r("a");
+      auto rs = r.signal<float>("local");
+      ready++;
+      for (;;) {
+        if (rs.read().value == 199.0f) break;
+        if (!r.wait(5000)) {
+          timeouts++;
+          break;
+        }
+      }
+      done++;
+    });
+  }
+  while (ready.load() < 3) std::this_thread::yield();
+  for (int i = 0; i < 200; ++i) {
+    ASSERT_EQ(s.write(static_cast<float>(i)), 0);
+    if (i % 10 == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  for (auto& t : th) t.join();
+  EXPECT_EQ(timeouts.load(), 0);
+  EXPECT_EQ(done.load(), 3);
+  EXPECT_EQ(seg_a_.header()->rx_waiters.load(), 0u);
+}
+
+// ccomm_set_time: writes carry the cycle time, reads judge freshness and age against
+// it (a value newer than the cycle time is fresh, age 0); 0 returns to the clock.
+TEST_F(ClientTest, CycleTimeStampsWritesAndJudgesReads) {
+  ccomm_client* w = nullptr;
+  ccomm_client* r = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &w), 0);
+  ASSERT_EQ(ccomm_open("a", 0, &r), 0);
+  ccomm_signal local = ccomm_find(w, "local");  // stale_after_ms = 1000
+  EXPECT_EQ(ccomm_set_time(nullptr, 1), CCOMM_E_INVAL);
+  EXPECT_EQ(ccomm_set_time(w, -1), CCOMM_E_INVAL);
+  const int64_t t0 = ccomm_now();
+  ASSERT_EQ(ccomm_set_time(w, t0 - 5000000), 0);  // the writer's cycle began 5 ms ago
+  ASSERT_EQ(ccomm_write_float(w, local, 1.5f), 0);
+  float v = 0;
+  ccomm_info info;
+  ASSERT_EQ(ccomm_read_float(r, local, &v, &info), CCOMM_FRESH);  // per-call clock
+  EXPECT_GE(info.age_ns, 5000000);
+  EXPECT_EQ(info.source_time_ns, static_cast<uint64_t>(t0 - 5000000));
+  ASSERT_EQ(ccomm_set_time(r, t0 - 6000000), 0);  // a cycle time before the write
+  ASSERT_EQ(ccomm_read_float(r, local, &v, &info), CCOMM_FRESH);
+  EXPECT_EQ(info.age_ns, 0);
+  ASSERT_EQ(ccomm_set_time(r, t0 + 2000000000), 0);  // 2 s later: stale
+  EXPECT_EQ(ccomm_read_float(r, local, &v, &info), CCOMM_STALE);
+  EXPECT_EQ(info.age_ns, 2005000000);
+  ASSERT_EQ(ccomm_set_time(r, 0), 0);
+  EXPECT_EQ(ccomm_read_float(r, local, &v, &info), CCOMM_FRESH);
+  ccomm_close(w);
+  ccomm_close(r);
 }
 
 TEST_F(ClientTest, RetiredSegmentIsReported) {

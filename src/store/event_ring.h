@@ -14,6 +14,9 @@
 //   - A writer killed (or stalled for a whole lap) between claiming a ticket and
 //     completing it leaves a hole: readers wait for it at most kHoleTimeoutNs, then
 //     skip it and count it lost. No reader stalls forever.
+//   - A reader polling an empty ring touches only the next slot's line (and `head`
+//     every kHeadRecheckNs), so writers keep `head` in their cache. Hence kEmpty means
+//     "nothing new as of at most kHeadRecheckNs ago" behind a hole, never longer.
 //   - Every loop is bounded.
 #pragma once
 
@@ -70,6 +73,7 @@ inline StoreResult RingWrite(const RingView& v, const void* value, uint64_t valu
   s->local_time_ns.store(local_time_ns, kMetaStore);
   StoreWords(reinterpret_cast<uint8_t*>(s + 1), value, v.value_bytes);
   s->seq.store(2 * h + 2, std::memory_order_release);
+  v.ring->published.fetch_add(1, std::memory_order_seq_cst);  // ccomm_wait's change counter (rx_waiters)
   if (seq_out) *seq_out = vs;
   return StoreResult::kOk;
 }
@@ -79,16 +83,24 @@ struct RingCursor {
   uint64_t next = 0;         // next ticket to read
   uint64_t stuck_since = 0;  // when `next` was first seen incomplete (0 = not stuck)
   uint64_t lost = 0;         // events this reader lost (overrun or skipped holes)
+  uint64_t known_head = 0;   // `head` at the last look (RingRead)
+  uint64_t head_seen_ns = 0; // when that look was
 };
+
+/// How long a reader that has caught up trusts its last look at `head` (RingRead).
+constexpr uint64_t kHeadRecheckNs = 100ull * 1000;
 
 /// Starts a cursor at the ring's current head (only events from now on).
 inline void RingSubscribe(const RingView& v, RingCursor* c) {
   c->next = v.ring->head.load(std::memory_order_acquire);
+  c->known_head = c->next;
+  c->head_seen_ns = 0;
   c->stuck_since = 0;
 }
 
 /// Pops the next event for this cursor: kOk, kEmpty, or kPending (the next event is
-/// claimed but not complete; try again). `now_ns` is used only to time out holes.
+/// claimed but not complete; try again). `now_ns` times out holes and spaces out the
+/// reader's looks at `head`; 0 = look every time.
 inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMeta* meta,
                             uint64_t now_ns) {
   for (int attempt = 0; attempt < 8; ++attempt) {
@@ -108,7 +120,15 @@ inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMet
       }
       continue;  // overwritten while copying: we were lapped; recheck below
     }
+    // Slot not yet claimed for ticket t and the reader has caught up with `head` as
+    // last seen: nothing new. Only `head` can tell a hole (a writer that died between
+    // its two claims) from an empty ring, but reading it on every poll would pull the
+    // writers' line to a spinning reader; it is looked at again after kHeadRecheckNs.
+    if (s1 < 2 * t + 1 && t >= c->known_head && now_ns && now_ns - c->head_seen_ns < kHeadRecheckNs)
+      return StoreResult::kEmpty;
     uint64_t head = v.ring->head.load(std::memory_order_acquire);
+    c->known_head = head;
+    c->head_seen_ns = now_ns;
     if (head <= t) return StoreResult::kEmpty;
     if (s1 > 2 * t + 2 || head - t > v.depth) {
       // Lapped: the oldest event still in the ring is head - depth.

@@ -101,6 +101,34 @@ TEST(EventRing, HoleFromDeadWriterIsSkippedAfterTimeout) {
   EXPECT_EQ(c.lost, 1u);
 }
 
+// A reader that has caught up does not look at `head` on every poll (it stays in the
+// writers' cache); a hole behind it (a ticket never claimed in its slot) is still found
+// once its last look is kHeadRecheckNs old, and skipped after the hole timeout.
+TEST(EventRing, CaughtUpReaderFindsAnUnclaimedHoleAfterRecheck) {
+  Ring r(8, false);
+  RingCursor c;
+  RingSubscribe(r.view, &c);
+  SlotMeta m;
+  uint64_t out = 0;
+  const uint64_t t0 = 1000000;
+  EXPECT_EQ(RingRead(r.view, &c, &out, &m, t0), StoreResult::kEmpty);  // looks at head once
+  r.view.ring->head.fetch_add(1);  // a writer takes ticket 0 and dies before its slot
+  uint64_t v = 7;
+  ASSERT_EQ(RingWrite(r.view, &v, 0, 0, 0), StoreResult::kOk);  // ticket 1
+  EXPECT_EQ(RingRead(r.view, &c, &out, &m, t0 + 1000), StoreResult::kEmpty);  // trusts its last look
+  const uint64_t t1 = t0 + kHeadRecheckNs;
+  EXPECT_EQ(RingRead(r.view, &c, &out, &m, t1), StoreResult::kPending);  // looked: a hole
+  EXPECT_EQ(RingRead(r.view, &c, &out, &m, t1 + 1000), StoreResult::kPending);
+  ASSERT_EQ(RingRead(r.view, &c, &out, &m, t1 + kHoleTimeoutNs + 1), StoreResult::kOk);
+  EXPECT_EQ(out, 7u);
+  EXPECT_EQ(c.lost, 1u);
+  // now_ns == 0: no clock, so every poll looks at head (nothing is trusted).
+  RingCursor d;
+  RingSubscribe(r.view, &d);
+  ASSERT_EQ(RingWrite(r.view, &v, 0, 0, 0), StoreResult::kOk);
+  EXPECT_EQ(RingRead(r.view, &d, &out, &m, 0), StoreResult::kOk);
+}
+
 // Two writers, two readers; each reader must account for every event exactly once:
 // received + lost == written, and per-writer values arrive in increasing order.
 TEST(EventRing, ConcurrentWritersAndReadersAccountForEveryEvent) {
@@ -128,9 +156,11 @@ TEST(EventRing, ConcurrentWritersAndReadersAccountForEveryEvent) {
       bool any[2] = {false, false};
       SlotMeta m;
       uint64_t v;
+      uint64_t empty_since = 0;
       for (;;) {
         uint64_t now = static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
         StoreResult res = RingRead(r.view, &cursors[k], &v, &m, now);
+        if (res != StoreResult::kEmpty) empty_since = 0;
         if (res == StoreResult::kOk) {
           received[k]++;
           uint64_t w = v >> 32, i = v & 0xffffffffu;
@@ -138,7 +168,10 @@ TEST(EventRing, ConcurrentWritersAndReadersAccountForEveryEvent) {
           last[w] = i;
           any[w] = true;
         } else if (res == StoreResult::kEmpty && writers_done.load() == 2) {
-          break;
+          // Caught up with `head` as last seen; drained once that look is old enough.
+          if (!empty_since) empty_since = now;
+          if (now - empty_since > 2 * kHeadRecheckNs) break;
+          std::this_thread::yield();
         } else {
           std::this_thread::yield();
         }

@@ -25,7 +25,7 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 2;
+constexpr uint32_t kLayoutVersion = 3;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
@@ -55,8 +55,11 @@ struct alignas(kCacheLine) SegmentHeader {
   // tx_doorbell and FUTEX_WAKE it only if ccommd said it is about to sleep.
   alignas(kCacheLine) std::atomic<uint32_t> tx_doorbell;
   std::atomic<uint32_t> tx_sleeping;
-  // Receive-side notification for ccomm_wait(): bumped on every store update; woken
-  // only when someone waits.
+  // Receive-side notification for ccomm_wait(), touched by writers only while someone
+  // waits: a writer publishes (a seq_cst RMW on the signal: `latest` or `published`),
+  // then loads rx_waiters; a waiter increments rx_waiters, then compares every signal's
+  // change counter with what it saw last. One of the two sees the other (Dekker), so a
+  // write is never missed, and writers do not share a line when nobody waits.
   alignas(kCacheLine) std::atomic<uint32_t> rx_doorbell;
   std::atomic<uint32_t> rx_waiters;
 
@@ -113,31 +116,51 @@ struct alignas(8) SlotHeader {
 };
 static_assert(sizeof(SlotHeader) == 40, "slot header is 5 words");
 
+// Values of at most this many bytes also live in the cell's first cache line (below).
+constexpr uint32_t kInlineValueBytes = 16;
+
+// A state cell: two cache lines, then kStateSlots slots (state_slot.h).
+// Line 0 is all a reader touches for a small value: `latest` and a copy of the newest
+// value under its own seqlock (`inline_seq`), so a hand-off moves one cache line, as a
+// bare shared variable does. Writers change line 0 only with plain stores and the one
+// CAS that publishes `latest`: who may fill the inline copy is decided on line 1
+// (`inline_claim`, a slot header's seq/owner protocol, reclaimed like a slot), which
+// readers never touch.
 struct alignas(kCacheLine) StateCell {
-  std::atomic<uint64_t> next_ticket;  // claimed tickets
   std::atomic<uint64_t> latest;       // ticket + 1 of the newest complete copy; 0 = never
+  std::atomic<uint64_t> inline_seq;   // 2t+1 while ticket t's value is copied in, 2t+2 complete
+  std::atomic<uint64_t> inline_meta[3];  // value_seq, source_time_ns, local_time_ns (as SlotHeader)
+  std::atomic<uint64_t> inline_value[kInlineValueBytes / 8];
+  alignas(kCacheLine) std::atomic<uint64_t> next_ticket;  // claimed tickets
   std::atomic<uint64_t> forwarded;    // `latest` value ccommd last sent (send-side bookkeeping)
+  SlotHeader inline_claim;            // seq/owner only: the writer filling the inline copy
   // followed (at the next cache line) by kStateSlots slots of slot_bytes each
 };
+static_assert(offsetof(StateCell, next_ticket) == kCacheLine, "a reader's part of a cell is one line");
 
 struct alignas(kCacheLine) EventRing {
   std::atomic<uint64_t> head;        // next ticket to claim
   std::atomic<uint64_t> fwd_cursor;  // next ticket ccommd will forward (forwarded signals)
+  std::atomic<uint64_t> published;   // events completed (seq_cst, after the slot): ccomm_wait's change counter
   // followed (at the next cache line) by queue_depth slots of slot_bytes each
 };
 
+// Two lines: what writers (applications, ccommd's send side) count, and what the
+// receive side counts and readers read (`lost`, `overflow`), so an application's
+// read does not pull the line every write of the same signal touches.
 struct alignas(kCacheLine) SignalStats {
   std::atomic<uint64_t> writes;       // local writes accepted
   std::atomic<uint64_t> write_errors; // local writes refused (full, busy)
   std::atomic<uint64_t> tx;           // values sent by ccommd
-  std::atomic<uint64_t> rx;           // values received by ccommd
+  std::atomic<uint64_t> coalesced;    // values replaced by a newer one before ccommd sent them
+                                      // (event-driven states when ccommd ran late)
+  alignas(kCacheLine) std::atomic<uint64_t> rx;  // values received by ccommd
   std::atomic<uint64_t> lost;         // gaps in the producer's sequence seen by ccommd
   std::atomic<uint64_t> overflow;     // events a reader lost to ring overrun (all readers)
   std::atomic<uint64_t> stale_transitions;  // fresh -> stale seen by ccommd's supervision
   std::atomic<uint64_t> last_rx_ns;
-  std::atomic<uint64_t> coalesced;    // values replaced by a newer one before ccommd sent them
-                                      // (event-driven states when ccommd ran late)
 };
+static_assert(sizeof(SignalStats) == 2 * kCacheLine, "writer line + receive line");
 
 struct alignas(kCacheLine) PeerStats {
   std::atomic<uint64_t> frames_rx;

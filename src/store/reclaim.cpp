@@ -18,6 +18,7 @@ void ForEachSlot(const Segment& s, Fn fn) {
     } else {
       StateView v = s.state(id);
       for (uint32_t i = 0; i < kStateSlots; ++i) fn(v.slot(i));
+      fn(&v.cell->inline_claim);  // same protocol; 0 frees it like a slot
     }
   }
 }

@@ -24,7 +24,11 @@ struct Plan {
   size_t directory, node_names, signal_stats, peer_stats, dirty, data, total;
 };
 
-size_t SlotBytes(const SignalConfig& s) { return sizeof(SlotHeader) + AlignUp(s.value_bytes(), 8); }
+// Whole cache lines: a slot never shares a line with its neighbour, so a writer filling
+// one slot does not pull the line a reader is copying the previous one from.
+size_t SlotBytes(const SignalConfig& s) {
+  return AlignUp(sizeof(SlotHeader) + AlignUp(s.value_bytes(), 8), kCacheLine);
+}
 
 size_t DataBytes(const SignalConfig& s) {
   size_t slots = s.kind == SignalKind::kEvent ? s.queue_depth : kStateSlots;
@@ -163,8 +167,10 @@ void Segment::NotifyTx(uint32_t id, bool wake) const {
 
 void Segment::NotifyRx() const {
   SegmentHeader* h = header();
+  // The caller's store published with a seq_cst RMW; this load is ordered after it.
+  if (!h->rx_waiters.load(std::memory_order_seq_cst)) return;
   h->rx_doorbell.fetch_add(1, std::memory_order_seq_cst);
-  if (h->rx_waiters.load(std::memory_order_seq_cst)) platform::FutexWake(&h->rx_doorbell, 1 << 30);
+  platform::FutexWake(&h->rx_doorbell, 1 << 30);
 }
 
 int Segment::Open(const std::string& name) {

@@ -71,7 +71,8 @@ class Segment {
   void RingTxDoorbell() const;
   /// MarkDirty, then bumps the doorbell, waking ccommd if `wake` (see layout.h).
   void NotifyTx(uint32_t id, bool wake) const;
-  /// Bumps rx_doorbell and wakes ccomm_wait() callers, if any.
+  /// Wakes ccomm_wait() callers, if any (call after a StateWrite/RingWrite; see
+  /// SegmentHeader::rx_waiters). No shared write when nobody waits.
   void NotifyRx() const;
 
   void* base() const { return base_; }

@@ -132,7 +132,7 @@ TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
   bool adopted;
   ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
   std::vector<SlotSuspect> suspects(SlotCount(d));
-  EXPECT_EQ(SlotCount(d), 4u + 4u + 16u);
+  EXPECT_EQ(SlotCount(d), (4u + 1u) + (4u + 1u) + 16u);  // states: 4 slots + the inline copy
   // A child claims a slot like a writer and dies before completing it.
   pid_t child = fork();
   if (child == 0) {
@@ -140,6 +140,11 @@ TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
     uint64_t t = v.cell->next_ticket.fetch_add(1);
     v.slot(t)->seq.store(2 * t + 1);
     v.slot(t)->owner.store((uint64_t{platform::ProcessId()} << 32) | t);
+    // ... and, in another cell, dies while filling the inline copy.
+    StateView w = d.state(1);
+    w.cell->inline_claim.seq.store(2 * 7 + 1);
+    w.cell->inline_claim.owner.store((uint64_t{platform::ProcessId()} << 32) | 7);
+    w.cell->inline_seq.store(2 * 7 + 1);
     _exit(0);
   }
   waitpid(child, nullptr, 0);
@@ -148,8 +153,9 @@ TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
   uint64_t t = v.cell->next_ticket.fetch_add(1);
   v.slot(t)->seq.store(2 * t + 1);
   v.slot(t)->owner.store((uint64_t{platform::ProcessId()} << 32) | t);
-  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 1u);
+  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 2u);
   EXPECT_EQ(v.slot(0)->seq.load(), 0u);       // the dead child's slot: free again
+  EXPECT_EQ(d.state(1).cell->inline_claim.seq.load(), 0u);
   EXPECT_EQ(v.slot(t)->seq.load(), 2 * t + 1);  // ours: untouched
   // A writer that died before writing its owner word: freed only after it stayed so for
   // kUnknownOwnerScans further scans.

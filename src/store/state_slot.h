@@ -6,6 +6,13 @@
 // stores seq = 2t+2 and raises `latest` to t+1. A reader copies slot (latest-1) and
 // accepts it only if seq == 2(latest-1)+2 before and after the copy (seqlock).
 //
+// Small values (<= kInlineValueBytes) are also copied into the cell's first line
+// (`inline_seq`, a seqlock whose writer is chosen by `inline_claim` on the writers'
+// line, claimed for the same ticket after the slot is complete),
+// and a reader takes that copy when it holds `latest`: the reader then touches one
+// cache line. The slot stays the durable copy: when the inline copy is being rewritten,
+// or its writer died, readers fall back to the slot.
+//
 // Invariants:
 //   - The slot holding `latest` is never claimed: a newer complete copy must exist
 //     before the newest one can be overwritten, so readers always find a valid copy.
@@ -45,6 +52,41 @@ struct StateView {
 
 enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull };
 
+/// Copies ticket t's value into the cell's inline copy unless a newer ticket holds it
+/// or another writer is filling it (then readers use the slot: nothing is lost). The
+/// claim is taken on line 1; line 0 sees only plain stores (see StateCell).
+inline void WriteInline(const StateView& v, uint64_t t, uint64_t value_seq, uint64_t source_time_ns,
+                        uint64_t local_time_ns, const void* value) {
+  StateCell* c = v.cell;
+  SlotHeader* claim = &c->inline_claim;
+  uint64_t s = claim->seq.load(std::memory_order_relaxed);
+  if ((s & 1) || s > 2 * t || !claim->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel))
+    return;
+  claim->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
+  c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
+  SeqlockWriterFence();
+  c->inline_meta[0].store(value_seq, kMetaStore);
+  c->inline_meta[1].store(source_time_ns, kMetaStore);
+  c->inline_meta[2].store(local_time_ns, kMetaStore);
+  StoreWords(reinterpret_cast<uint8_t*>(c->inline_value), value, v.value_bytes);
+  c->inline_seq.store(2 * t + 2, std::memory_order_release);
+  claim->seq.store(2 * t + 2, std::memory_order_release);
+}
+
+/// Copies a seqlocked value (seq word, the three meta words, the value) if it holds
+/// complete ticket t.
+inline bool ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta3, const uint8_t* data,
+                     uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+  uint64_t s1 = seq->load(std::memory_order_acquire);
+  if (s1 != 2 * t + 2) return false;
+  meta->value_seq = meta3[0].load(kMetaLoad);
+  meta->source_time_ns = meta3[1].load(kMetaLoad);
+  meta->local_time_ns = meta3[2].load(kMetaLoad);
+  LoadWords(out, data, value_bytes);
+  SeqlockReaderFence();
+  return seq->load(std::memory_order_relaxed) == s1;
+}
+
 /// Writes a value. value_seq == 0 means "number it": the ticket + 1 is used.
 /// Returns kOk or kBusy. On kOk, *seq_out (if given) is the value's sequence number.
 inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t value_seq,
@@ -66,11 +108,12 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
     h->local_time_ns.store(local_time_ns, kMetaStore);
     StoreWords(reinterpret_cast<uint8_t*>(h + 1), value, v.value_bytes);
     h->seq.store(2 * t + 2, std::memory_order_release);
+    if (v.value_bytes <= kInlineValueBytes) WriteInline(v, t, vs, source_time_ns, local_time_ns, value);
     // Publish: raise latest to t+1 unless a newer copy is already published. Each
     // failed CAS means another writer published, so this ends within #writers tries.
     uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
     while (cur < t + 1 &&
-           !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_release,
+           !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst,  // see rx_waiters
                                                  std::memory_order_relaxed)) {
     }
     if (seq_out) *seq_out = vs;
@@ -80,21 +123,21 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
 }
 
 /// Copies the newest complete value. Returns kOk, kNever (nothing written yet) or
-/// kBusy (writers overtook the reader 16 times in a row).
-inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
+/// kBusy (writers overtook the reader 16 times in a row). On kOk, *version_out (if
+/// given) is the `latest` of the copy (StateVersion then says if it is still newest).
+inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta, uint64_t* version_out = nullptr) {
   for (int attempt = 0; attempt < 16; ++attempt) {
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
     if (latest == 0) return StoreResult::kNever;
     uint64_t t = latest - 1;
     const SlotHeader* h = v.slot(t);
-    uint64_t s1 = h->seq.load(std::memory_order_acquire);
-    if (s1 != 2 * t + 2) continue;
-    meta->value_seq = h->value_seq.load(kMetaLoad);
-    meta->source_time_ns = h->source_time_ns.load(kMetaLoad);
-    meta->local_time_ns = h->local_time_ns.load(kMetaLoad);
-    LoadWords(out, reinterpret_cast<const uint8_t*>(h + 1), v.value_bytes);
-    SeqlockReaderFence();
-    if (h->seq.load(std::memory_order_relaxed) == s1) return StoreResult::kOk;
+    if ((v.value_bytes <= kInlineValueBytes &&
+         ReadCopy(&v.cell->inline_seq, v.cell->inline_meta, reinterpret_cast<const uint8_t*>(v.cell->inline_value),
+                  t, v.value_bytes, out, meta)) ||
+        ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta)) {
+      if (version_out) *version_out = latest;
+      return StoreResult::kOk;
+    }
   }
   return StoreResult::kBusy;
 }

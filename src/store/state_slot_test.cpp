@@ -109,18 +109,74 @@ TEST(StateSlot, TwoDeadWritersStillWork) {
   }
 }
 
+// Small values are also in the cell's first line, for ticket `latest - 1` only.
+TEST(StateSlot, SmallValuesAreCopiedInline) {
+  Cell small(16), big(24);
+  uint64_t a[3] = {1, 2, 3};
+  ASSERT_EQ(StateWrite(small.view, a, 0, 5, 6), StoreResult::kOk);
+  ASSERT_EQ(StateWrite(big.view, a, 0, 5, 6), StoreResult::kOk);
+  EXPECT_EQ(small.view.cell->inline_seq.load(), 2u);  // ticket 0, complete
+  EXPECT_EQ(small.view.cell->inline_claim.seq.load(), 2u);  // and released
+  EXPECT_EQ(small.view.cell->inline_value[1].load(), 2u);
+  EXPECT_EQ(small.view.cell->inline_meta[2].load(), 6u);  // local time
+  EXPECT_EQ(big.view.cell->inline_seq.load(), 0u);  // too big: slots only
+  // A reader takes the inline copy: make the slot unreadable and read anyway.
+  small.view.slot(0)->seq.store(99);
+  uint64_t out[2] = {};
+  SlotMeta m;
+  ASSERT_EQ(StateRead(small.view, out, &m), StoreResult::kOk);
+  EXPECT_EQ(out[1], 2u);
+  EXPECT_EQ(m.value_seq, 1u);
+}
+
+// A writer killed while filling the inline copy leaves it odd: readers use the slots,
+// later writers skip the inline copy, and nothing is lost or torn.
+TEST(StateSlot, DeadInlineWriterFallsBackToSlots) {
+  Cell c(8);
+  double v = 1.0;
+  ASSERT_EQ(StateWrite(c.view, &v, 0, 0, 0), StoreResult::kOk);
+  uint64_t t = c.view.cell->next_ticket.fetch_add(1);  // the dead writer's ticket
+  c.view.cell->inline_claim.seq.store(2 * t + 1);
+  c.view.cell->inline_seq.store(2 * t + 1);
+  c.view.cell->inline_value[0].store(0xABABABABABABABABull);
+  double out = 0;
+  SlotMeta m;
+  ASSERT_EQ(StateRead(c.view, &out, &m), StoreResult::kOk);
+  EXPECT_EQ(out, 1.0);
+  for (int i = 0; i < 20; ++i) {
+    double w = 10.0 + i;
+    ASSERT_EQ(StateWrite(c.view, &w, 0, 0, 0), StoreResult::kOk);
+    ASSERT_EQ(StateRead(c.view, &out, &m), StoreResult::kOk);
+    EXPECT_EQ(out, w);
+  }
+  EXPECT_EQ(c.view.cell->inline_claim.seq.load(), 2 * t + 1);  // untouched until reclaimed
+  EXPECT_EQ(c.view.cell->inline_seq.load(), 2 * t + 1);
+  c.view.cell->inline_claim.seq.store(0);                      // what ccommd's reclaim does
+  double w = 99.0;
+  ASSERT_EQ(StateWrite(c.view, &w, 0, 0, 0), StoreResult::kOk);
+  EXPECT_EQ(c.view.cell->inline_seq.load() % 2, 0u);
+  EXPECT_GT(c.view.cell->inline_seq.load(), 2 * t + 2);
+  ASSERT_EQ(StateRead(c.view, &out, &m), StoreResult::kOk);
+  EXPECT_EQ(out, 99.0);
+}
+
 // Writers put N identical words per value; a torn read would mix two values.
-TEST(StateSlot, ConcurrentReadersNeverSeeTornValues) {
-  constexpr int kWords = 36;
+// 2 words go through the inline copy, 36 through the slots only.
+class StateSlotConcurrent : public testing::TestWithParam<int> {};
+INSTANTIATE_TEST_SUITE_P(Sizes, StateSlotConcurrent, testing::Values(2, 36));
+
+TEST_P(StateSlotConcurrent, ReadersNeverSeeTornValues) {
+  constexpr int kMaxWords = 36;
+  const int kWords = GetParam();
   Cell c(kWords * 8);
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> reads{0}, busy{0};
   std::vector<std::thread> threads;
   for (int w = 0; w < 2; ++w) {
     threads.emplace_back([&, w] {
-      uint64_t vals[kWords];
+      uint64_t vals[kMaxWords];
       for (uint64_t i = 1; !stop.load(std::memory_order_relaxed); ++i) {
-        for (auto& x : vals) x = (i << 8) | static_cast<uint64_t>(w);
+        for (int k = 0; k < kWords; ++k) vals[k] = (i << 8) | static_cast<uint64_t>(w);
         StateWrite(c.view, vals, 0, 0, 0);
       }
     });
@@ -128,7 +184,7 @@ TEST(StateSlot, ConcurrentReadersNeverSeeTornValues) {
   std::atomic<int> torn{0};
   for (int r = 0; r < 2; ++r) {
     threads.emplace_back([&] {
-      uint64_t vals[kWords];
+      uint64_t vals[kMaxWords];
       SlotMeta m;
       while (!stop.load(std::memory_order_relaxed)) {
         StoreResult res = StateRead(c.view, vals, &m);

@@ -43,20 +43,33 @@ inline void SeqlockWriterFence() { std::atomic_thread_fence(std::memory_order_re
 inline void SeqlockReaderFence() { std::atomic_thread_fence(std::memory_order_acquire); }
 #endif
 
+// Whole words with a constant-size memcpy (a plain load/store), the tail word apart:
+// a variable-size memcpy per word would be a library call per word.
 inline void StoreWords(uint8_t* shm, const void* src, size_t len) {
   const uint8_t* s = static_cast<const uint8_t*>(src);
-  for (size_t i = 0; i < len; i += 8) {
-    uint64_t w = 0;
-    std::memcpy(&w, s + i, len - i < 8 ? len - i : 8);  // the tail word is zero-padded
+  const size_t full = len & ~size_t{7};
+  for (size_t i = 0; i < full; i += 8) {
+    uint64_t w;
+    std::memcpy(&w, s + i, 8);
     __atomic_store_n(reinterpret_cast<uint64_t*>(shm + i), w, kDataStoreOrder);
+  }
+  if (full != len) {
+    uint64_t w = 0;  // the tail word is zero-padded
+    std::memcpy(&w, s + full, len - full);
+    __atomic_store_n(reinterpret_cast<uint64_t*>(shm + full), w, kDataStoreOrder);
   }
 }
 
 inline void LoadWords(void* dst, const uint8_t* shm, size_t len) {
   uint8_t* d = static_cast<uint8_t*>(dst);
-  for (size_t i = 0; i < len; i += 8) {
+  const size_t full = len & ~size_t{7};
+  for (size_t i = 0; i < full; i += 8) {
     uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm + i), kDataLoadOrder);
-    std::memcpy(d + i, &w, len - i < 8 ? len - i : 8);
+    std::memcpy(d + i, &w, 8);
+  }
+  if (full != len) {
+    uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm + full), kDataLoadOrder);
+    std::memcpy(d + full, &w, len - full);
   }
 }
 

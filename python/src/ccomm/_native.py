@@ -125,6 +125,10 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
     # ctypes releases the GIL during foreign calls: other threads run while this blocks.
     L.ccomm_wait.argtypes = [vp, ctypes.c_int]
     L.ccomm_wait.restype = ctypes.c_int
+    L.ccomm_set_time.argtypes = [vp, ctypes.c_int64]
+    L.ccomm_set_time.restype = ctypes.c_int
+    L.ccomm_now.argtypes = []
+    L.ccomm_now.restype = ctypes.c_int64
     L.ccomm_daemon_alive.argtypes = [vp]
     L.ccomm_daemon_alive.restype = ctypes.c_int
     return L

@@ -309,9 +309,22 @@ class Client:
     def write(self, name: str, value: ValueLike) -> None:
         self.signal(name).write(value)
 
+    def set_time(self, t_ns: int = 0) -> None:
+        """Cycle time: this client's reads judge freshness and age against `t_ns`
+        (CLOCK_MONOTONIC ns, e.g. Client.now()) and its writes are stamped with it, until
+        the next call; 0 returns to reading the clock in every call."""
+        _check(_native.lib().ccomm_set_time(self._handle(), int(t_ns)), "set_time")
+
+    @staticmethod
+    def now() -> int:
+        """CLOCK_MONOTONIC in ns: the clock of every ccomm time stamp and age."""
+        return int(_native.lib().ccomm_now())
+
     def wait(self, timeout: Optional[float] = None) -> bool:
-        """Blocks until a signal of this node changes (True) or `timeout` seconds pass
-        (False); None waits forever. Releases the GIL while waiting."""
+        """Blocks until a signal of this node has changed since the previous wait()
+        returned, or since the open (True), or `timeout` seconds pass (False); None waits
+        forever, 0 just looks. A write between your reads and this call is not missed.
+        Releases the GIL while waiting."""
         ms = -1 if timeout is None else max(0, int(math.ceil(timeout * 1000.0)))
         return _check(_native.lib().ccomm_wait(self._handle(), ms), "wait") == 1
 

@@ -149,9 +149,26 @@ CCOMM_API int ccomm_read_bool(ccomm_client* c, ccomm_signal s, int* v, ccomm_inf
 CCOMM_API int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v);
 
 /**
- * Blocks until any signal of this node changes (a value arrives from the network or a
- * local write) or `timeout_ms` passes (< 0: forever). Returns 1 if woken by a change,
- * 0 on timeout. For non-real-time consumers; a control loop just reads each cycle.
+ * Cycle time. A control loop that reads and writes several signals per cycle can take
+ * the time once per cycle: after ccomm_set_time(c, t_ns), this handle's reads judge
+ * freshness and age against t_ns, and its writes are stamped t_ns (the cycle's sample
+ * instant), instead of reading CLOCK_MONOTONIC in every call, until the next
+ * ccomm_set_time(). A value that arrived after t_ns reads as fresh with age 0.
+ * t_ns = 0 returns to one clock reading per call (the default). Real-time safe; no
+ * syscall. Returns 0, or CCOMM_E_INVAL for a NULL handle or a negative time.
+ */
+CCOMM_API int ccomm_set_time(ccomm_client* c, int64_t t_ns);
+
+/** CLOCK_MONOTONIC in nanoseconds: the clock of every ccomm time stamp and age. */
+CCOMM_API int64_t ccomm_now(void);
+
+/**
+ * Blocks until any signal of this node has changed (a value arrived from the network or
+ * was written locally) since the previous ccomm_wait() on this handle returned (or since
+ * ccomm_open), or `timeout_ms` passes (< 0: forever; 0: just look). Returns 1 if
+ * something changed, 0 on timeout. A change between the caller's reads and this call is
+ * never missed: it returns at once. Costs one look at every signal of the node; for
+ * non-real-time consumers (a control loop just reads each cycle).
  */
 CCOMM_API int ccomm_wait(ccomm_client* c, int timeout_ms);
 

@@ -110,6 +110,10 @@ class Client {
   }
   int last_error() const { return error_; }
 
+  /// Cycle time for this handle's reads and writes (see ccomm_set_time); 0 = per call.
+  void set_time(int64_t t_ns) { ccomm_set_time(c_, t_ns); }
+  static int64_t now() { return ccomm_now(); }
+
   /// Blocks until something changes (non-real-time consumers).
   bool wait(int timeout_ms) { return ccomm_wait(c_, timeout_ms) == 1; }
   bool daemon_alive() const { return ccomm_daemon_alive(c_) == 1; }

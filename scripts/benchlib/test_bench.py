@@ -48,7 +48,8 @@ class ConfigTest(unittest.TestCase):
 
     def test_local_config_is_valid(self):
         out = self.check(ccomm.local_config(80, 0))
-        self.assertIn("1 nodes, 37 signals", out)
+        # 36 states + 1 event for ccomm-latency, and ccomm_pingpong's three pairs.
+        self.assertIn("1 nodes, %d signals" % (37 + 2 * len(ccomm.PINGPONG)), out)
 
     def test_setup_names_match_default_config(self):
         with open(os.path.join(REPO, "dist", "signals.xml")) as f:

@@ -21,13 +21,15 @@ using ccomm::store::SlotMeta;
 using ccomm::store::StoreResult;
 namespace st = ccomm::store;
 
-// The last copy a handle took of a state signal larger than the inline copy: while
-// `latest` is unchanged a read copies from here, so a handle polling a signal does not
-// pull the writer's slot lines to its CPU (the writer then keeps them in its cache).
+// The last copy a handle took of a state signal: while the cell's change words are
+// unchanged a read copies from here. A handle polling a signal then reads one or two
+// words of the cell per poll: it does not pull the writer's slot lines to its CPU, and
+// it holds the readers' line for as short a time as possible while the writer wants it.
 struct StateCache {
-  uint64_t version = 0;  // `latest` of the copy; 0 = none
+  uint64_t version = 0;      // `latest` seen before the copy; 0 = none
+  uint64_t inline_seq = 0;   // small values: the inline copy's sequence seen before it
   SlotMeta meta;
-  uint8_t* value = nullptr;  // value_bytes; null for small (inline) and event signals
+  uint8_t* value = nullptr;  // value_bytes; null for event signals
 };
 
 // One signal as a handle sees it, resolved at open: a read or write touches this, the
@@ -78,25 +80,27 @@ bool TakeChanges(ccomm_client* c) {
   return changed;
 }
 
-size_t CachedBytes(const SignalDirectoryEntry& d) {
-  return (d.flags & st::kSigEvent) || d.value_bytes <= st::kInlineValueBytes ? 0 : d.value_bytes;
-}
+size_t CachedBytes(const SignalDirectoryEntry& d) { return (d.flags & st::kSigEvent) ? 0 : d.value_bytes; }
 
-// Reads a state through the handle's cache (see StateCache).
+// Reads a state through the handle's cache (see StateCache). The change words are read
+// before the copy, so the copy is at least as new as they say; if they move during
+// the copy, the next read copies again.
 StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
   StateCache& k = h.cache;
-  if (!k.value) return st::StateRead(h.state, value, meta);
-  if (k.version && st::StateVersion(h.state) == k.version) {
+  const st::StateCell* cell = h.state.cell;
+  const uint64_t version = cell->latest.load(std::memory_order_acquire);
+  const uint64_t iseq = h.value_bytes <= st::kInlineValueBytes ? cell->inline_seq.load(std::memory_order_acquire) : 0;
+  if (version && version == k.version && iseq == k.inline_seq) {
     memcpy(value, k.value, h.value_bytes);
     *meta = k.meta;
     return StoreResult::kOk;
   }
-  uint64_t version = 0;
-  StoreResult r = st::StateRead(h.state, value, meta, &version);
+  StoreResult r = st::StateRead(h.state, value, meta);
   if (r == StoreResult::kOk) {
     memcpy(k.value, value, h.value_bytes);
     k.meta = *meta;
     k.version = version;
+    k.inline_seq = iseq;
   }
   return r;
 }

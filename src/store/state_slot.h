@@ -8,9 +8,11 @@
 //
 // Small values (<= kInlineValueBytes) are also copied into the cell's first line
 // (`inline_seq`, a seqlock whose writer is chosen by `inline_claim` on the writers'
-// line, claimed for the same ticket after the slot is complete),
-// and a reader takes that copy when it holds `latest`: the reader then touches one
-// cache line. The slot stays the durable copy: when the inline copy is being rewritten,
+// line, claimed for the same ticket after the slot is complete and held until `latest`
+// is published),
+// and a reader takes that copy when it is complete and not older than `latest` (it may
+// be the next value, whose writer has not published yet): the reader then touches one
+// cache line, and sees a new value as soon as the copy's stores land. The slot stays the durable copy: when the inline copy is being rewritten,
 // or its writer died, readers fall back to the slot.
 //
 // Invariants:
@@ -52,17 +54,23 @@ struct StateView {
 
 enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull };
 
-/// Copies ticket t's value into the cell's inline copy unless a newer ticket holds it
-/// or another writer is filling it (then readers use the slot: nothing is lost). The
-/// claim is taken on line 1; line 0 sees only plain stores (see StateCell).
-inline void WriteInline(const StateView& v, uint64_t t, uint64_t value_seq, uint64_t source_time_ns,
-                        uint64_t local_time_ns, const void* value) {
-  StateCell* c = v.cell;
-  SlotHeader* claim = &c->inline_claim;
+/// Claims the cell's inline copy for ticket t, unless a newer ticket holds it or
+/// another writer is filling it (then readers use the slot: nothing is lost). The
+/// claim lives on line 1; the holder fills line 0 with plain stores (FillInline),
+/// publishes `latest` and only then releases the claim (ReleaseInline), so the inline
+/// copy is never older than `latest - 1` while it is complete (see StateRead).
+inline bool ClaimInline(const StateView& v, uint64_t t) {
+  SlotHeader* claim = &v.cell->inline_claim;
   uint64_t s = claim->seq.load(std::memory_order_relaxed);
   if ((s & 1) || s > 2 * t || !claim->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel))
-    return;
+    return false;
   claim->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
+  return true;
+}
+
+inline void FillInline(const StateView& v, uint64_t t, uint64_t value_seq, uint64_t source_time_ns,
+                       uint64_t local_time_ns, const void* value) {
+  StateCell* c = v.cell;
   c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
   SeqlockWriterFence();
   c->inline_meta[0].store(value_seq, kMetaStore);
@@ -70,7 +78,10 @@ inline void WriteInline(const StateView& v, uint64_t t, uint64_t value_seq, uint
   c->inline_meta[2].store(local_time_ns, kMetaStore);
   StoreWords(reinterpret_cast<uint8_t*>(c->inline_value), value, v.value_bytes);
   c->inline_seq.store(2 * t + 2, std::memory_order_release);
-  claim->seq.store(2 * t + 2, std::memory_order_release);
+}
+
+inline void ReleaseInline(const StateView& v, uint64_t t) {
+  v.cell->inline_claim.seq.store(2 * t + 2, std::memory_order_release);
 }
 
 /// Copies a seqlocked value (seq word, the three meta words, the value) if it holds
@@ -108,7 +119,8 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
     h->local_time_ns.store(local_time_ns, kMetaStore);
     StoreWords(reinterpret_cast<uint8_t*>(h + 1), value, v.value_bytes);
     h->seq.store(2 * t + 2, std::memory_order_release);
-    if (v.value_bytes <= kInlineValueBytes) WriteInline(v, t, vs, source_time_ns, local_time_ns, value);
+    const bool inl = v.value_bytes <= kInlineValueBytes && ClaimInline(v, t);
+    if (inl) FillInline(v, t, vs, source_time_ns, local_time_ns, value);
     // Publish: raise latest to t+1 unless a newer copy is already published. Each
     // failed CAS means another writer published, so this ends within #writers tries.
     uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
@@ -116,6 +128,7 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
            !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst,  // see rx_waiters
                                                  std::memory_order_relaxed)) {
     }
+    if (inl) ReleaseInline(v, t);
     if (seq_out) *seq_out = vs;
     return StoreResult::kOk;
   }
@@ -130,11 +143,23 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta, uint
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
     if (latest == 0) return StoreResult::kNever;
     uint64_t t = latest - 1;
+    if (v.value_bytes <= kInlineValueBytes) {
+      // The inline copy, if complete and not older than `latest`: it may be newer (its
+      // writer has not published yet), never older than anything a later read can
+      // fall back to, since its writer publishes before another can refill it.
+      uint64_t s1 = v.cell->inline_seq.load(std::memory_order_acquire);
+      if (!(s1 & 1) && s1 >= 2 * t + 2) {
+        uint64_t ti = s1 / 2 - 1;
+        if (ReadCopy(&v.cell->inline_seq, v.cell->inline_meta, reinterpret_cast<const uint8_t*>(v.cell->inline_value),
+                     ti, v.value_bytes, out, meta)) {
+          if (version_out) *version_out = latest;
+          return StoreResult::kOk;
+        }
+        continue;  // refilled while we copied
+      }
+    }
     const SlotHeader* h = v.slot(t);
-    if ((v.value_bytes <= kInlineValueBytes &&
-         ReadCopy(&v.cell->inline_seq, v.cell->inline_meta, reinterpret_cast<const uint8_t*>(v.cell->inline_value),
-                  t, v.value_bytes, out, meta)) ||
-        ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta)) {
+    if (ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta)) {
       if (version_out) *version_out = latest;
       return StoreResult::kOk;
     }

@@ -578,11 +578,21 @@ def _ontarget_why(R, meta):
                     " (one reading costs %.0f ns here, and a hand-off has one in the write and one in the "
                     "read)" % cc["clock_read_ns"] if cc.get("clock_read_ns") else "")
             t.append(line + ".")
+    cs, ce = R.get("ccomm_pp_state_spin_cycle_b2b_p8"), R.get("ccomm_pp_event_spin_cycle_b2b_p8")
+    if cs and ce and cs.get("paired_ratio") and ce.get("paired_ratio"):
+        t.append("State against event, same run, same API calls around them: %.2fx against %.2fx the floor "
+                 "interleaved with each. Both readers poll one cache line; the difference is the writer's "
+                 "side of the multi-writer state cell: a ticket, the slot claim, the claim of the readers' "
+                 "line copy and the CAS that publishes `latest` (four atomic read-modify-writes, against the "
+                 "ring's three), and the copy into both the slot and the readers' line. The slot is what "
+                 "keeps a value safe from a writer killed in the middle of its copy, and every atomic "
+                 "read-modify-write waits until the writer's stores before it are visible." % (
+                     cs["paired_ratio"], ce["paired_ratio"]))
     cl = (meta.get("cost") or {}).get("callgrind_client")
     if cl:
         pc = {w.split(" (")[0]: x for w, _, x in cl["per_call"]}
-        t.append("Instructions per call (callgrind, section 4; the vDSO clock reads are not counted): "
-                 "`ccomm_write_double` %s, `ccomm_read_double` %s." % (
+        t.append("The profile, instructions per call (callgrind, section 4; the vDSO clock reads are not "
+                 "counted): `ccomm_write_double` %s, `ccomm_read_double` %s." % (
                      pc.get("ccomm_write_double", "?"), pc.get("ccomm_read_double", "?")))
     i = R.get("iox_spin_b2b_p8")
     if i and f:

@@ -293,6 +293,16 @@ static inline void bench_opts_defaults(bench_opts *o, const char *name, long pay
     o->timeout_ns = 1000LL * 1000 * 1000;
 }
 
+/* The index of `arg` in the NULL-terminated `words`, or -1: option values that name one
+ * of a few modes (e.g. --role echo|ping), in the order of the program's enum. */
+static inline int bench_choice(const char *arg, const char *const *words)
+{
+    for (int i = 0; words[i]; i++)
+        if (!strcmp(arg, words[i]))
+            return i;
+    return -1;
+}
+
 static inline int bench_parse_u64(const char *s, uint64_t *out)
 {
     char *end;

@@ -307,23 +307,21 @@ int main(int argc, char **argv)
             continue;
         int bad = r < 0;
         switch (opt) {
-        case OPT_ROLE:
+        case OPT_ROLE: {
+            static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
+            int k = bench_choice(optarg, roles);
             have_role = 1;
-            if (!strcmp(optarg, "echo"))
-                role = R_ECHO;
-            else if (!strcmp(optarg, "ping"))
-                role = R_PING;
-            else
-                bad = 1;
+            role = (enum role)k;
+            bad = k < 0;
             break;
-        case OPT_WAIT:
-            if (!strcmp(optarg, "spin"))
-                wait = W_SPIN;
-            else if (!strcmp(optarg, "block"))
-                wait = W_BLOCK;
-            else
-                bad = 1;
+        }
+        case OPT_WAIT: {
+            static const char *const waits[] = {"spin", "block", NULL}; /* enum waitmode */
+            int k = bench_choice(optarg, waits);
+            wait = (enum waitmode)k;
+            bad = k < 0;
             break;
+        }
         case OPT_NODE: node = optarg; break;
         case OPT_PING: ping_name = optarg; break;
         case OPT_PONG: pong_name = optarg; break;

@@ -161,17 +161,17 @@ int main(int argc, char **argv)
             return BENCH_EXIT_USAGE;
         }
         switch (opt) {
-        case OPT_ROLE:
-            have_role = 1;
-            if (!strcmp(optarg, "echo"))
-                c.role = R_ECHO;
-            else if (!strcmp(optarg, "ping"))
-                c.role = R_PING;
-            else {
+        case OPT_ROLE: {
+            static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
+            int k = bench_choice(optarg, roles);
+            if (k < 0) {
                 fprintf(stderr, "unknown role %s\n", optarg);
                 return BENCH_EXIT_USAGE;
             }
+            have_role = 1;
+            c.role = (enum role)k;
             break;
+        }
         case OPT_URL: url = optarg; break;
         case OPT_PERSIST: c.persist = 1; break;
         case OPT_START:

@@ -572,19 +572,14 @@ int main(int argc, char **argv)
             else
                 bad = 1;
             break;
-        case OPT_ROLE:
+        case OPT_ROLE: {
+            static const char *const roles[] = {"echo", "ping", "source", "sink", NULL}; /* enum role */
+            int k = bench_choice(optarg, roles);
             have_r = 1;
-            if (!strcmp(optarg, "echo"))
-                r.role = R_ECHO;
-            else if (!strcmp(optarg, "ping"))
-                r.role = R_PING;
-            else if (!strcmp(optarg, "source"))
-                r.role = R_SOURCE;
-            else if (!strcmp(optarg, "sink"))
-                r.role = R_SINK;
-            else
-                bad = 1;
+            r.role = (enum role)k;
+            bad = k < 0;
             break;
+        }
         case OPT_IF: r.ep.ifname = optarg; break;
         case OPT_ET:
             bad = bench_parse_u64(optarg, &u) || u < 0x0600 || u > 0xFFFF;

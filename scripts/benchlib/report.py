@@ -727,6 +727,16 @@ clock, so on two boards measure round trips (RTT/2) or synchronise the clocks (P
 6. Check the framing: `ccomm stats --json` on the receiving board, `peers[].frames_rx` minus
    `heartbeats_rx` against the `sent` cycles `ccomm-latency` prints.
 
+On one board (on-target), with `ccommd` running for a node whose file has two state doubles
+`ping8`, `pong8` produced there (see `scripts/benchlib/ccomm.py`, `local_config`):
+
+   ```
+   ccomm_pingpong --role echo --node NODE --ping ping8 --pong pong8 --payload 8 --cpu 1 --floor-shm /ccpp-1 --cycle-time &
+   ccomm_pingpong --role ping --node NODE --ping ping8 --pong pong8 --payload 8 --cpu 0 --floor-shm /ccpp-1 --cycle-time --half --count 50000
+   ```
+   It prints ccomm's RTT/2 and, measured in blocks between the same two processes, the bare
+   cache-line floor (`floor_p50_ns`) and the median block ratio (`paired_ratio`).
+
 `scripts/bench` itself drives namespaces on one host; its building blocks
 (`scripts/benchlib/ccomm.py`: configuration generator, `Daemons`, `latency_argv`) take the
 node names, addresses and CPUs as parameters.

@@ -8,18 +8,33 @@ namespace store {
 
 namespace {
 
+// Calls fn(slot header, cell) for every slot; cell is set for a state cell's inline
+// claim (the same seq/owner protocol: 0 frees it like a slot), null otherwise.
 template <typename Fn>
 void ForEachSlot(const Segment& s, Fn fn) {
   for (uint32_t id = 0; id < s.signal_count(); ++id) {
     const SignalDirectoryEntry& d = s.dir(id);
     if (d.flags & kSigEvent) {
       RingView r = s.ring(id);
-      for (uint32_t i = 0; i < r.depth; ++i) fn(r.slot(i));
+      for (uint32_t i = 0; i < r.depth; ++i) fn(r.slot(i), static_cast<const StateView*>(nullptr));
     } else {
       StateView v = s.state(id);
-      for (uint32_t i = 0; i < kStateSlots; ++i) fn(v.slot(i));
-      fn(&v.cell->inline_claim);  // same protocol; 0 frees it like a slot
+      for (uint32_t i = 0; i < kStateSlots; ++i) fn(v.slot(i), static_cast<const StateView*>(nullptr));
+      fn(&v.cell->inline_claim, &v);
     }
+  }
+}
+
+// A writer that died holding a cell's inline claim for ticket t had completed its slot
+// and may have filled the readers' line copy, but not published `latest`. Readers may
+// already have taken that copy; once the claim is free and the copy is refilled they
+// fall back to the slot of `latest`, which would be older. So publish ticket t first,
+// as its writer would have, if its slot still holds it complete.
+void PublishDeadInlineWriter(const StateView& v, uint64_t t) {
+  if (v.slot(t)->seq.load(std::memory_order_acquire) != 2 * t + 2) return;
+  uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
+  while (cur < t + 1 &&
+         !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst, std::memory_order_relaxed)) {
   }
 }
 
@@ -27,13 +42,13 @@ void ForEachSlot(const Segment& s, Fn fn) {
 
 size_t SlotCount(const Segment& s) {
   size_t n = 0;
-  ForEachSlot(s, [&](SlotHeader*) { n++; });
+  ForEachSlot(s, [&](SlotHeader*, const StateView*) { n++; });
   return n;
 }
 
 size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspects) {
   size_t i = 0, reclaimed = 0;
-  ForEachSlot(s, [&](SlotHeader* h) {
+  ForEachSlot(s, [&](SlotHeader* h, const StateView* cell) {
     SlotSuspect& prev = (*suspects)[i++];
     uint64_t seq = h->seq.load(std::memory_order_acquire);
     if (!(seq & 1)) {
@@ -48,6 +63,7 @@ size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspect
     bool dead = owner_known ? !platform::ProcessAlive(static_cast<uint32_t>(owner >> 32))
                             : prev.scans >= kUnknownOwnerScans;  // claimed, owner never written
     if (dead) {
+      if (cell) PublishDeadInlineWriter(*cell, ticket);
       uint64_t expected = seq;
       if (h->seq.compare_exchange_strong(expected, 0, std::memory_order_acq_rel)) reclaimed++;
       prev = SlotSuspect();

@@ -9,6 +9,8 @@
 // write the owner word (owner names an older ticket, and the slot stayed odd with the
 // same seq for kUnknownOwnerScans scans, i.e. seconds, for two instructions' work).
 // A slow but live writer is not touched, so its late stores never land in a reused slot.
+// A state cell's inline claim is reclaimed the same way, after publishing the dead
+// holder's ticket if its slot is complete (readers may have seen its line copy).
 // Limit: pids are those of ccommd's pid namespace; writers in another pid namespace
 // (a container with its own) must not share a segment with this ccommd.
 #pragma once

@@ -166,6 +166,49 @@ TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
   EXPECT_EQ(r.slot(5)->seq.load(), 0u);
 }
 
+// A writer killed after filling the readers' line copy but before publishing `latest`:
+// readers may have taken the copy, so the reclaim publishes the (complete) slot of that
+// ticket before freeing the claim, and values never go back once the copy is refilled.
+TEST_F(SegmentTest, ReclaimPublishesADeadInlineWritersValue) {
+  Segment d;
+  std::string err;
+  bool adopted;
+  ASSERT_EQ(d.CreateOrAdopt(Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0);
+  std::vector<SlotSuspect> suspects(SlotCount(d));
+  StateView v = d.state(0);  // "pos", one double
+  double x = 1.0;
+  ASSERT_EQ(StateWrite(v, &x, 0, 1, 1), StoreResult::kOk);  // ticket 0, published
+  pid_t child = fork();
+  if (child == 0) {
+    // Ticket 1: slot complete, line copy filled, claim held, `latest` not raised.
+    uint64_t t = v.cell->next_ticket.fetch_add(1);
+    double y = 2.0;
+    SlotHeader* h = v.slot(t);
+    h->seq.store(2 * t + 1);
+    StoreWords(reinterpret_cast<uint8_t*>(h + 1), &y, 8);
+    h->seq.store(2 * t + 2);
+    ASSERT_TRUE(ClaimInline(v, t));
+    FillInline(v, t, t + 1, 2, 2, &y);
+    _exit(0);
+  }
+  waitpid(child, nullptr, 0);
+  SlotMeta m;
+  double out = 0;
+  ASSERT_EQ(StateRead(v, &out, &m), StoreResult::kOk);
+  EXPECT_EQ(out, 2.0);  // readers already see the dead writer's value in the line copy
+  EXPECT_EQ(v.cell->latest.load(), 1u);
+  EXPECT_EQ(ReclaimAbandonedSlots(d, &suspects), 1u);
+  EXPECT_EQ(v.cell->latest.load(), 2u);  // published before the claim was freed
+  EXPECT_EQ(v.cell->inline_claim.seq.load(), 0u);
+  // The next writer refills the copy; a reader caught in the middle falls back to the
+  // slot of `latest`: 2.0, never the older 1.0.
+  uint64_t t = v.cell->next_ticket.fetch_add(1);
+  ASSERT_TRUE(ClaimInline(v, t));
+  v.cell->inline_seq.store(2 * t + 1);  // being refilled
+  ASSERT_EQ(StateRead(v, &out, &m), StoreResult::kOk);
+  EXPECT_EQ(out, 2.0);
+}
+
 }  // namespace
 }  // namespace store
 }  // namespace ccomm

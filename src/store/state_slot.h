@@ -136,9 +136,8 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
 }
 
 /// Copies the newest complete value. Returns kOk, kNever (nothing written yet) or
-/// kBusy (writers overtook the reader 16 times in a row). On kOk, *version_out (if
-/// given) is the `latest` of the copy (StateVersion then says if it is still newest).
-inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta, uint64_t* version_out = nullptr) {
+/// kBusy (writers overtook the reader 16 times in a row).
+inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
   for (int attempt = 0; attempt < 16; ++attempt) {
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
     if (latest == 0) return StoreResult::kNever;
@@ -151,18 +150,14 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta, uint
       if (!(s1 & 1) && s1 >= 2 * t + 2) {
         uint64_t ti = s1 / 2 - 1;
         if (ReadCopy(&v.cell->inline_seq, v.cell->inline_meta, reinterpret_cast<const uint8_t*>(v.cell->inline_value),
-                     ti, v.value_bytes, out, meta)) {
-          if (version_out) *version_out = latest;
+                     ti, v.value_bytes, out, meta))
           return StoreResult::kOk;
-        }
         continue;  // refilled while we copied
       }
     }
     const SlotHeader* h = v.slot(t);
-    if (ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta)) {
-      if (version_out) *version_out = latest;
+    if (ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta))
       return StoreResult::kOk;
-    }
   }
   return StoreResult::kBusy;
 }

@@ -40,6 +40,9 @@ const char kUsage[] =
     "                           daemon, peer and signal counters: rates, loss, staleness\n"
     "  gen 20sim4c SIGNALS.XML OUTDIR\n"
     "                           generate the 20-sim 4C I/O component for this node\n"
+    "  record, replay, web, ros2 ...\n"
+    "                           run the installed tool ccomm-COMMAND (see its --help):\n"
+    "                           MCAP recording and replay, live view, ROS 2 bridge\n"
     "\n"
     "Options:\n"
     "  -n, --node NAME          node to attach to (default: $CCOMM_NODE, else hostname)\n"
@@ -261,6 +264,24 @@ int CmdGen(const char* node, int argc, char** argv) {
   return 1;
 }
 
+// `ccomm X ARGS` for a command this program does not know runs `ccomm-X ARGS` from PATH
+// (git-style), so tools shipped by other packages (Python, the ROS 2 bridge) are one CLI.
+int RunExternal(const char* node, const char* cmd, int argc, char** argv) {
+  std::string prog = std::string("ccomm-") + cmd;
+  if (node) setenv("CCOMM_NODE", node, 1);
+  std::vector<char*> args;
+  args.push_back(&prog[0]);
+  for (int i = 1; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execvp(prog.c_str(), args.data());
+  if (errno == ENOENT) {
+    fprintf(stderr, "ccomm: unknown command '%s' (no %s in PATH)\n%s", cmd, prog.c_str(), kUsage);
+    return 2;
+  }
+  fprintf(stderr, "ccomm: cannot run %s: %s\n", prog.c_str(), strerror(errno));
+  return 1;
+}
+
 }  // namespace
 
 int CmdStats(ccomm_client* c, const char* node, int argc, char** argv);  // stats.cpp
@@ -288,8 +309,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "gen") == 0) return CmdGen(node, sub_argc, sub_argv);
   if (strcmp(cmd, "help") == 0) { fputs(kUsage, stdout); return 0; }
   if (strcmp(cmd, "list") && strcmp(cmd, "echo") && strcmp(cmd, "pub") && strcmp(cmd, "stats")) {
-    fprintf(stderr, "ccomm: unknown command '%s'\n%s", cmd, kUsage);
-    return 2;
+    return RunExternal(node, cmd, sub_argc, sub_argv);
   }
   ccomm_client* c = nullptr;
   if (Open(node, &c) != 0) return 1;

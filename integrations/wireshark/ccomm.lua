@@ -1,0 +1,484 @@
+-- SPDX-License-Identifier: Apache-2.0
+-- Wireshark dissector for ccomm frames (wire format v1, docs/protocol.md), on raw
+-- Ethernet (EtherType 0x88B5) and UDP (port 47800, plus a heuristic for other ports).
+--
+--   tshark -X lua_script:ccomm.lua -r capture.pcap -O ccomm
+--   cp ccomm.lua ~/.local/lib/wireshark/plugins/      (Wireshark and tshark load it)
+--
+-- It checks every frame the way the receiver's DecodeHeader() does, in the same order,
+-- and raises one expert info per problem ("bad_entry: entry 0: unknown type 7"); the
+-- first one, which is what ccommd would count, is also the field ccomm.decode_error.
+-- With the preference ccomm.config (a signals.xml) it names nodes and signals and flags
+-- entries that do not match the configuration (receiver rule 6, bad_signal).
+-- Documentation: docs/integrations/wireshark.md.
+
+local ccomm = Proto("ccomm", "ccomm signal frames")
+
+local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16
+local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46
+local MAGIC, VERSION = 0x43434D57, 1
+local F_HEARTBEAT, F_AUTH, F_KNOWN = 0x01, 0x02, 0x03
+local E_EVENT, E_KNOWN = 0x01, 0x01
+local DEST_ALL = 0xFFFF
+
+-- code -> name, element size (docs/protocol.md "Types")
+local TYPES = {
+  [1] = { name = "bool", size = 1 },
+  [2] = { name = "int32", size = 4 },
+  [3] = { name = "uint32", size = 4 },
+  [4] = { name = "int64", size = 8 },
+  [5] = { name = "float", size = 4 },
+  [6] = { name = "double", size = 8 },
+}
+local TYPE_NAMES = {}
+for code, t in pairs(TYPES) do TYPE_NAMES[code] = t.name end
+
+local f = {
+  magic = ProtoField.uint32("ccomm.magic", "magic", base.HEX),
+  version = ProtoField.uint8("ccomm.version", "version", base.DEC),
+  flags = ProtoField.uint8("ccomm.flags", "flags", base.HEX),
+  flag_heartbeat = ProtoField.bool("ccomm.flags.heartbeat", "heartbeat", 8, nil, F_HEARTBEAT),
+  flag_auth = ProtoField.bool("ccomm.flags.auth", "authentication tag present", 8, nil, F_AUTH),
+  flag_unknown = ProtoField.uint8("ccomm.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFC),
+  sender = ProtoField.uint16("ccomm.sender", "sender", base.DEC),
+  config_hash = ProtoField.uint32("ccomm.config_hash", "config_hash", base.HEX),
+  seq = ProtoField.uint32("ccomm.seq", "seq", base.DEC),
+  send_time_ns = ProtoField.uint64("ccomm.send_time_ns", "send_time_ns", base.DEC),
+  entry_count = ProtoField.uint16("ccomm.entry_count", "entry_count", base.DEC),
+  payload_len = ProtoField.uint16("ccomm.payload_len", "payload_len", base.DEC),
+  dest = ProtoField.uint16("ccomm.dest", "dest", base.DEC),
+  reserved = ProtoField.uint16("ccomm.reserved", "reserved", base.HEX),
+  entry = ProtoField.none("ccomm.entry", "entry"),
+  e_signal = ProtoField.uint16("ccomm.entry.signal", "signal", base.DEC),
+  e_type = ProtoField.uint8("ccomm.entry.type", "type", base.DEC, TYPE_NAMES),
+  e_flags = ProtoField.uint8("ccomm.entry.flags", "flags", base.HEX),
+  e_flag_event = ProtoField.bool("ccomm.entry.flags.event", "event (queued; clear: state)", 8, nil, E_EVENT),
+  e_flag_unknown = ProtoField.uint8("ccomm.entry.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFE),
+  e_count = ProtoField.uint16("ccomm.entry.count", "count", base.DEC),
+  e_value_len = ProtoField.uint16("ccomm.entry.value_len", "value_len", base.DEC),
+  e_seq = ProtoField.uint32("ccomm.entry.seq", "seq", base.DEC),
+  e_reserved = ProtoField.uint32("ccomm.entry.reserved", "reserved", base.HEX),
+  e_source_time_ns = ProtoField.uint64("ccomm.entry.source_time_ns", "source_time_ns", base.DEC),
+  e_value = ProtoField.string("ccomm.entry.value", "value"),
+  e_value_bytes = ProtoField.bytes("ccomm.entry.value_bytes", "value bytes (not decodable)"),
+  e_padding = ProtoField.bytes("ccomm.entry.padding", "padding"),
+  v_bool = ProtoField.bool("ccomm.entry.value.bool", "bool", base.NONE),
+  v_int32 = ProtoField.int32("ccomm.entry.value.int32", "int32", base.DEC),
+  v_uint32 = ProtoField.uint32("ccomm.entry.value.uint32", "uint32", base.DEC),
+  v_int64 = ProtoField.int64("ccomm.entry.value.int64", "int64", base.DEC),
+  v_float = ProtoField.float("ccomm.entry.value.float", "float"),
+  v_double = ProtoField.double("ccomm.entry.value.double", "double"),
+  unused = ProtoField.bytes("ccomm.unused", "payload bytes after the last entry"),
+  auth_tag = ProtoField.bytes("ccomm.auth_tag", "authentication tag (keyed BLAKE2b-128, not verified here)"),
+  trailing = ProtoField.bytes("ccomm.trailing", "trailing bytes"),
+  decode_error = ProtoField.string("ccomm.decode_error", "decode error (first failure, as ccommd counts it)"),
+  sender_name = ProtoField.string("ccomm.sender_name", "sender node"),
+  dest_name = ProtoField.string("ccomm.dest_name", "destination node"),
+  e_signal_name = ProtoField.string("ccomm.entry.signal_name", "signal name"),
+}
+local field_list = {}
+for _, field in pairs(f) do field_list[#field_list + 1] = field end
+ccomm.fields = field_list
+
+-- One expert info per DecodeError of docs/protocol.md "Validation", plus the receiver's
+-- bad_signal (rule 6, only with a configuration loaded) and notes.
+local E = {}
+for _, name in ipairs({ "too_short", "bad_magic", "bad_version", "bad_header", "bad_entry", "trailing_bytes" }) do
+  E[name] = ProtoExpert.new("ccomm." .. name, name, expert.group.MALFORMED, expert.severity.ERROR)
+end
+E.bad_signal = ProtoExpert.new("ccomm.bad_signal", "bad_signal", expert.group.PROTOCOL, expert.severity.WARN)
+E.note = ProtoExpert.new("ccomm.note", "note", expert.group.COMMENTS_GROUP, expert.severity.NOTE)
+ccomm.experts = { E.too_short, E.bad_magic, E.bad_version, E.bad_header, E.bad_entry,
+                  E.trailing_bytes, E.bad_signal, E.note }
+
+ccomm.prefs.udp_port = Pref.uint("UDP port", 47800, "UDP port of ccomm frames (<network udp_port=...>)")
+ccomm.prefs.ethertype = Pref.uint("EtherType", 0x88B5, "EtherType of raw ccomm frames (<network ethertype=...>)")
+ccomm.prefs.config = Pref.string("signals.xml", "",
+  "Path of the system's signals.xml: names nodes and signals, checks entries against it")
+
+local udp_port_field = Field.new("udp.port")
+
+
+-- ---- optional configuration (signals.xml) ---------------------------------------------
+-- Nodes and signals are numbered by their position in the file (docs/config.md); the
+-- hash is SystemConfig::hash (FNV-1a 32 over the canonical form, docs/config.md).
+local config = { path = "", nodes = {}, node_ids = {}, signals = {}, hash = nil, error = nil }
+
+local function xml_attr(tag, name)
+  local v = tag:match("%s" .. name .. "%s*=%s*\"([^\"]*)\"") or tag:match("%s" .. name .. "%s*=%s*'([^']*)'")
+  return v and v:gsub("^%s+", ""):gsub("%s+$", "") or nil
+end
+
+local function fnv1a32(text)
+  local h = 2166136261
+  for i = 1, #text do
+    h = bit32.bxor(h, text:byte(i))
+    -- h * 16777619 mod 2^32 without losing bits in a double: 16777619 = 2^24 + 403
+    h = ((h % 256) * 16777216 + h * 403) % 4294967296
+  end
+  return h
+end
+
+local function load_config(path)
+  config = { path = path, nodes = {}, node_ids = {}, signals = {}, hash = nil, error = nil }
+  if path == "" then return end
+  local fh, err = io.open(path, "r")
+  if not fh then config.error = "cannot read signals.xml: " .. tostring(err); return end
+  local text = fh:read("*a"):gsub("<!%-%-.-%-%->", "")  -- comments may hold example tags
+  fh:close()
+  local ethertype, udp_port, nn, ns = 34997, 47800, 0, 0
+  local canon_signals = {}
+  for kind, tag in text:gmatch("<(%a+)(%s[^>]*)>") do
+    if kind == "network" then
+      ethertype = tonumber(xml_attr(tag, "ethertype") or "") or ethertype
+      udp_port = tonumber(xml_attr(tag, "udp_port") or "") or udp_port
+    elseif kind == "node" then
+      local name = xml_attr(tag, "name") or "?"
+      config.nodes[nn], config.node_ids[name] = name, nn
+      nn = nn + 1
+    elseif kind == "signal" then
+      local sig = { name = xml_attr(tag, "name") or "?", type_name = xml_attr(tag, "type") or "?",
+                    count = tonumber(xml_attr(tag, "count") or "1") or 1,
+                    kind = xml_attr(tag, "kind") or "state", producer = xml_attr(tag, "producer") or "?",
+                    consumers = xml_attr(tag, "consumers") or "" }
+      for code, t in pairs(TYPES) do if t.name == sig.type_name then sig.type = code end end
+      config.signals[ns], canon_signals[#canon_signals + 1] = sig, sig
+      ns = ns + 1
+    end
+  end
+  local lines = { "ccomm-config 1", string.format("network %d %d", ethertype, udp_port) }
+  for i = 0, nn - 1 do lines[#lines + 1] = "node " .. config.nodes[i] end
+  for _, sig in ipairs(canon_signals) do
+    local ids = {}
+    for name in sig.consumers:gmatch("[^,%s]+") do ids[#ids + 1] = config.node_ids[name] or -1 end
+    table.sort(ids)
+    local names = {}
+    for _, id in ipairs(ids) do names[#names + 1] = config.nodes[id] or "?" end
+    lines[#lines + 1] = string.format("signal %s %s %d %s %s %s", sig.name, sig.type_name, sig.count,
+                                      sig.kind, sig.producer, #names > 0 and table.concat(names, ",") or "-")
+  end
+  config.hash = fnv1a32(table.concat(lines, "\n") .. "\n")
+end
+
+-- ---- value formatting ------------------------------------------------------------------
+-- Shortest text that reads back as the same value (like Python's repr).
+local function format_double(v)
+  if v ~= v then return "nan" end
+  if v == math.huge then return "inf" elseif v == -math.huge then return "-inf" end
+  for digits = 1, 17 do
+    local s = string.format("%." .. digits .. "g", v)
+    if tonumber(s) == v then return s end
+  end
+  return string.format("%.17g", v)
+end
+
+local function format_float(v, raw)
+  if v ~= v or v == math.huge or v == -math.huge then return format_double(v) end
+  for digits = 1, 9 do
+    local s = string.format("%." .. digits .. "g", v)
+    if Struct.pack(">f", tonumber(s)) == raw then return s end
+  end
+  return string.format("%.9g", v)
+end
+
+local function format_ns(u64)  -- "1000000000" -> "1.000000000 s"
+  local s = tostring(u64)
+  if #s < 10 then s = string.rep("0", 10 - #s) .. s end
+  return s:sub(1, -10) .. "." .. s:sub(-9) .. " s"
+end
+
+local function node_label(id)
+  if id == DEST_ALL then return "all" end
+  local name = config.nodes[id]
+  return name and string.format("%d (%s)", id, name) or tostring(id)
+end
+
+-- ---- dissection ------------------------------------------------------------------------
+-- Context of one frame: the tree, the first failure (what DecodeHeader would return).
+local function problem(ctx, item, kind, text)
+  item:add_proto_expert_info(E[kind], kind .. ": " .. text)
+  if not ctx.first then ctx.first, ctx.first_text = kind, text end
+end
+
+local function all_zero(tvb, off, len)
+  for i = off, off + len - 1 do
+    if tvb(i, 1):uint() ~= 0 then return false end
+  end
+  return true
+end
+
+-- Adds a well-formed value: ccomm.entry.value (all elements as text), under it one typed
+-- item per element (ccomm.entry.value.double ...) for filters. Returns the text.
+local function add_value(tree, tvb, off, code, count, fail)
+  local t = TYPES[code]
+  local texts = {}
+  for i = 0, count - 1 do
+    local r = tvb(off + i * t.size, t.size)
+    if code == 1 then texts[i + 1] = (r:uint() == 1) and "true" or (r:uint() == 0 and "false" or tostring(r:uint()))
+    elseif code == 2 then texts[i + 1] = tostring(r:int())
+    elseif code == 3 then texts[i + 1] = tostring(r:uint())
+    elseif code == 4 then texts[i + 1] = tostring(r:int64())
+    elseif code == 5 then texts[i + 1] = format_float(r:float(), r:raw())
+    else texts[i + 1] = format_double(r:float()) end
+  end
+  local text = table.concat(texts, ", ")
+  local value_item = tree:add(f.e_value, tvb(off, count * t.size), text)
+  for i = 0, count - 1 do
+    local r = tvb(off + i * t.size, t.size)
+    local item = value_item:add(f["v_" .. t.name], r)
+    item:set_text(string.format("%s%s: %s", t.name, count > 1 and "[" .. i .. "]" or "", texts[i + 1]))
+    if code == 1 and r:uint() > 1 then fail(item, "a bool byte other than 0 or 1 (" .. r:uint() .. ")") end
+  end
+  return text
+end
+
+-- One entry at `off` with `left` declared payload bytes; returns its size, or nil when
+-- the rest of the payload cannot be walked.
+local function dissect_entry(ctx, tvb, off, left, index, sender)
+  local tree = ctx.root
+  if left < ENTRY_HEADER then
+    problem(ctx, tree, "bad_entry", string.format("entry %d: less than 24 bytes of payload left (%d)", index, left))
+    return nil
+  end
+  if off + ENTRY_HEADER > tvb:len() then
+    tree:add_proto_expert_info(E.note, string.format("entry %d: not in the captured bytes", index))
+    return nil
+  end
+  local function bad(item, text) problem(ctx, item, "bad_entry", string.format("entry %d: %s", index, text)) end
+  local signal, code, eflags = tvb(off, 2):uint(), tvb(off + 2, 1):uint(), tvb(off + 3, 1):uint()
+  local count, value_len = tvb(off + 4, 2):uint(), tvb(off + 6, 2):uint()
+  local padded = value_len + (-value_len % 8)
+  local size = ENTRY_HEADER + padded
+  local sub = tree:add(f.entry, tvb(off, math.min(size, left, tvb:len() - off)))
+  local sig = config.signals[signal]
+  local t = TYPES[code]
+  sub:set_text(string.format("entry %d: signal %d%s, %s%s, %s, seq %d", index, signal,
+    sig and " (" .. sig.name .. ")" or "", t and t.name or "type " .. code, count ~= 1 and "[" .. count .. "]" or "",
+    bit32.band(eflags, E_EVENT) ~= 0 and "event" or "state", tvb(off + 8, 4):uint()))
+  sub:add(f.e_signal, tvb(off, 2))
+  if sig then sub:add(f.e_signal_name, tvb(off, 2), sig.name):set_generated() end
+  local type_item = sub:add(f.e_type, tvb(off + 2, 1))
+  local flags_item = sub:add(f.e_flags, tvb(off + 3, 1))
+  flags_item:add(f.e_flag_event, tvb(off + 3, 1))
+  flags_item:add(f.e_flag_unknown, tvb(off + 3, 1))
+  local count_item = sub:add(f.e_count, tvb(off + 4, 2))
+  local len_item = sub:add(f.e_value_len, tvb(off + 6, 2))
+  sub:add(f.e_seq, tvb(off + 8, 4))
+  local res_item = sub:add(f.e_reserved, tvb(off + 12, 4))
+  local time_item = sub:add(f.e_source_time_ns, tvb(off + 16, 8))
+  time_item:append_text(" (" .. format_ns(tvb(off + 16, 8):uint64()) .. ")")
+
+  -- the checks of CheckEntry(), in its order
+  local ok = true
+  local function fail(item, text) ok = false; bad(item, text) end
+  if not t then fail(type_item, "unknown type " .. code) end
+  if bit32.band(eflags, bit32.bnot(E_KNOWN)) ~= 0 then
+    fail(flags_item, string.format("unknown entry flag bits 0x%02x", bit32.band(eflags, 0xFE)))
+  end
+  if count == 0 then fail(count_item, "count 0") end
+  if t and count > 0 and value_len ~= count * t.size then
+    fail(len_item, string.format("value_len %d not count x element size (%d x %d = %d)", value_len, count, t.size, count * t.size))
+  end
+  if tvb(off + 12, 4):uint() ~= 0 then fail(res_item, string.format("reserved not 0 (0x%08x)", tvb(off + 12, 4):uint())) end
+  if size > left then
+    fail(sub, string.format("value and padding running past the payload (entry needs %d bytes, %d left)", size, left))
+    return nil
+  end
+  local voff = off + ENTRY_HEADER
+  if voff + padded > tvb:len() then
+    sub:add_proto_expert_info(E.note, "value not in the captured bytes")
+    return size
+  end
+  if ok then
+    sub:append_text(": " .. add_value(sub, tvb, voff, code, count, fail))
+  elseif value_len > 0 then
+    sub:add(f.e_value_bytes, tvb(voff, value_len))
+  end
+  if padded > value_len then
+    local pad_item = sub:add(f.e_padding, tvb(voff + value_len, padded - value_len))
+    if not all_zero(tvb, voff + value_len, padded - value_len) then fail(pad_item, "a non-zero padding byte") end
+  end
+
+  -- receiver rule 6 against the loaded configuration (the frame itself is well-formed)
+  if ok and config.hash and ctx.hash_ok then
+    local want = sig
+    local why
+    if not want then why = "no signal " .. signal .. " in signals.xml"
+    elseif config.node_ids[want.producer] ~= sender then why = "produced by " .. want.producer .. ", not by the sender"
+    elseif want.type ~= code then why = "signals.xml says type " .. want.type_name
+    elseif want.count ~= count then why = "signals.xml says count " .. want.count
+    elseif (want.kind == "event") ~= (bit32.band(eflags, E_EVENT) ~= 0) then why = "signals.xml says kind " .. want.kind end
+    if why then sub:add_proto_expert_info(E.bad_signal, "bad_signal: " .. why) end
+  end
+  return size
+end
+
+local function dissect(tvb, pinfo, tree)
+  local clen = tvb:len()               -- captured bytes
+  local rlen = tvb:reported_length_remaining()  -- bytes on the wire (a snap length may cut)
+  if rlen <= 0 then return 0 end
+  local over_udp = udp_port_field() ~= nil
+  pinfo.cols.protocol:set("CCOMM")
+
+  -- Raw Ethernet pads payloads under 46 bytes with zeros: drop them as
+  -- TrimEthernetPadding() does (protocol.md "Transport encapsulation"). UDP has none.
+  local flen = rlen
+  if not over_udp and rlen >= HEADER and rlen <= ETH_MIN_PAYLOAD and clen == rlen then
+    local declared = HEADER + tvb(26, 2):uint() + (bit32.band(tvb(5, 1):uint(), F_AUTH) ~= 0 and TAG_SIZE or 0)
+    if declared < rlen and all_zero(tvb, declared, rlen - declared) then flen = declared end
+  end
+
+  local root = tree:add(ccomm, tvb(0, math.min(flen, clen)))
+  local ctx = { root = root }
+  local function add(field, off, size)
+    if off + size <= clen then return root:add(field, tvb(off, size)) end
+  end
+  local function finish(summary)
+    if config.error then root:add_proto_expert_info(E.note, config.error) end
+    if flen < rlen then
+      root:add_proto_expert_info(E.note, string.format("%d zero byte(s) after the frame: Ethernet padding, dropped as a raw receiver does", rlen - flen))
+    end
+    if ctx.first then
+      root:add(f.decode_error, ctx.first):set_generated()
+      summary = summary .. " [" .. ctx.first .. ": " .. ctx.first_text .. "]"
+    end
+    root:append_text(", " .. summary)
+    pinfo.cols.info:set(summary)
+    return flen
+  end
+
+  -- 1. fewer than 32 bytes
+  if flen < HEADER then
+    local magic_item = add(f.magic, 0, 4)
+    add(f.version, 4, 1)
+    add(f.flags, 5, 1)
+    add(f.sender, 6, 2)
+    add(f.config_hash, 8, 4)
+    add(f.seq, 12, 4)
+    add(f.send_time_ns, 16, 8)
+    add(f.entry_count, 24, 2)
+    add(f.payload_len, 26, 2)
+    add(f.dest, 28, 2)
+    problem(ctx, magic_item or root, "too_short", string.format("fewer than 32 bytes (%d)", flen))
+    return finish(string.format("%d bytes", flen))
+  end
+
+  local magic, version, flags = tvb(0, 4):uint(), tvb(4, 1):uint(), tvb(5, 1):uint()
+  local sender, seq = tvb(6, 2):uint(), tvb(12, 4):uint()
+  local entry_count, payload_len = tvb(24, 2):uint(), tvb(26, 2):uint()
+  local dest, reserved = tvb(28, 2):uint(), tvb(30, 2):uint()
+  local heartbeat = bit32.band(flags, F_HEARTBEAT) ~= 0
+  local auth = bit32.band(flags, F_AUTH) ~= 0
+
+  local magic_item = root:add(f.magic, tvb(0, 4))
+  local version_item = root:add(f.version, tvb(4, 1))
+  local flags_item = root:add(f.flags, tvb(5, 1))
+  flags_item:add(f.flag_heartbeat, tvb(5, 1))
+  flags_item:add(f.flag_auth, tvb(5, 1))
+  flags_item:add(f.flag_unknown, tvb(5, 1))
+  local sender_item = root:add(f.sender, tvb(6, 2))
+  if config.nodes[sender] then root:add(f.sender_name, tvb(6, 2), config.nodes[sender]):set_generated() end
+  local hash_item = root:add(f.config_hash, tvb(8, 4))
+  root:add(f.seq, tvb(12, 4))
+  root:add(f.send_time_ns, tvb(16, 8)):append_text(" (" .. format_ns(tvb(16, 8):uint64()) .. ")")
+  local count_item = root:add(f.entry_count, tvb(24, 2))
+  local plen_item = root:add(f.payload_len, tvb(26, 2))
+  local dest_item = root:add(f.dest, tvb(28, 2))
+  if dest == DEST_ALL then dest_item:append_text(" (all nodes)") end
+  if config.nodes[dest] then root:add(f.dest_name, tvb(28, 2), config.nodes[dest]):set_generated() end
+  local res_item = root:add(f.reserved, tvb(30, 2))
+  local summary = string.format("%s %s -> %s, seq %d", heartbeat and "heartbeat" or "data",
+                                node_label(sender), node_label(dest), seq)
+  if not heartbeat then summary = summary .. string.format(", %d entr%s", entry_count, entry_count == 1 and "y" or "ies") end
+
+  -- 2. magic and version: without them the layout of the rest is unknown
+  if magic ~= MAGIC then
+    problem(ctx, magic_item, "bad_magic", string.format("wrong magic 0x%08x (expected 0x43434d57, \"CCMW\")", magic))
+    return finish(summary)
+  end
+  if version ~= VERSION then
+    problem(ctx, version_item, "bad_version", string.format("wrong version %d (this dissector knows version 1)", version))
+    return finish(summary)
+  end
+
+  -- 3. the header's own rules
+  if bit32.band(flags, bit32.bnot(F_KNOWN)) ~= 0 then
+    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", bit32.band(flags, 0xFC)))
+  end
+  if reserved ~= 0 then problem(ctx, res_item, "bad_header", string.format("reserved not 0 (0x%04x)", reserved)) end
+  if heartbeat and (entry_count ~= 0 or payload_len ~= 0) then
+    problem(ctx, count_item, "bad_header", "a heartbeat with entries or payload")
+  elseif not heartbeat and (entry_count == 0 or payload_len == 0) then
+    problem(ctx, count_item, "bad_header", "a data frame without entries or payload")
+  end
+  if payload_len % 8 ~= 0 then
+    problem(ctx, plen_item, "bad_header", string.format("payload_len %d not a multiple of 8", payload_len))
+  end
+  local total = HEADER + payload_len + (auth and TAG_SIZE or 0)
+  if total > MAX_FRAME then
+    problem(ctx, plen_item, "bad_header", string.format("declared total %d above 1472", total))
+  else
+    -- 4. received length against the declared one
+    if flen < total then
+      problem(ctx, plen_item, "too_short", string.format("received length %d below the declared total %d", flen, total))
+    elseif flen > total then
+      local item = total < clen and root:add(f.trailing, tvb(total, math.min(flen, clen) - total)) or root
+      problem(ctx, item, "trailing_bytes", string.format("received length %d above the declared total %d", flen, total))
+    end
+  end
+
+  -- configuration (receiver rule 4), only when a signals.xml is loaded
+  ctx.hash_ok = config.hash ~= nil and tvb(8, 4):uint() == config.hash
+  if config.hash and not ctx.hash_ok then
+    hash_item:add_proto_expert_info(E.bad_signal, string.format(
+      "config_mismatch: signals.xml (%s) hashes to %08x", config.path, config.hash))
+  end
+
+  -- 5. the entries, within the declared payload (and what was captured)
+  -- (a frame cut short shows its entries up to the end of the captured bytes)
+  local off, left, walked = HEADER, payload_len, true
+  for i = 0, entry_count - 1 do
+    local size = dissect_entry(ctx, tvb, off, left, i, sender)
+    if not size then walked = false; break end
+    off, left = off + size, left - size
+  end
+  -- 6. payload left over after entry_count entries
+  if walked and left > 0 then
+    local item = off < clen and root:add(f.unused, tvb(off, math.min(left, clen - off))) or root
+    problem(ctx, item, "bad_header", string.format("payload bytes left after entry_count entries (%d)", left))
+  end
+
+  if auth and HEADER + payload_len + TAG_SIZE <= math.min(flen, clen) then
+    root:add(f.auth_tag, tvb(HEADER + payload_len, TAG_SIZE))
+  end
+  return finish(summary)
+end
+
+function ccomm.dissector(tvb, pinfo, tree)
+  return dissect(tvb, pinfo, tree)
+end
+
+-- UDP on another port than the preference: frames that start with magic and version 1.
+local function heuristic(tvb, pinfo, tree)
+  if tvb:len() < 8 or tvb(0, 4):uint() ~= MAGIC or tvb(4, 1):uint() ~= VERSION then return false end
+  dissect(tvb, pinfo, tree)
+  return true
+end
+
+local registered = { udp_port = nil, ethertype = nil }
+local function register()
+  local udp, eth = DissectorTable.get("udp.port"), DissectorTable.get("ethertype")
+  if registered.udp_port then udp:remove(registered.udp_port, ccomm) end
+  if registered.ethertype then eth:remove(registered.ethertype, ccomm) end
+  registered.udp_port, registered.ethertype = ccomm.prefs.udp_port, ccomm.prefs.ethertype
+  udp:add(registered.udp_port, ccomm)
+  eth:add(registered.ethertype, ccomm)
+end
+
+function ccomm.prefs_changed()
+  register()
+  if ccomm.prefs.config ~= config.path then load_config(ccomm.prefs.config) end
+end
+
+register()
+ccomm:register_heuristic("udp", heuristic)

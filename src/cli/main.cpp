@@ -17,8 +17,6 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
-#include "common/platform.h"
-#include "store/segment.h"
 
 namespace {
 
@@ -145,7 +143,7 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
   ccomm_signal s = Find(c, argv[optind], &d);
   if (s < 0) return 1;
   std::vector<uint8_t> buf(d.value_bytes);
-  uint64_t start = ccomm::platform::MonotonicNs(), last_seq = 0;
+  uint64_t start = static_cast<uint64_t>(ccomm_now()), last_seq = 0;
   long printed = 0;
   bool first = true;
   while (!g_stop && (count < 0 || printed < count)) {
@@ -169,7 +167,7 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
       if (once) return 0;
       if (d.is_event && interval_ms <= 0) continue;  // drain queued events before waiting
     }
-    if (timeout >= 0 && (ccomm::platform::MonotonicNs() - start) / 1e9 > timeout) break;
+    if (timeout >= 0 && (static_cast<uint64_t>(ccomm_now()) - start) / 1e9 > timeout) break;
     if (interval_ms > 0) {
       struct timespec ts = {interval_ms / 1000, (interval_ms % 1000) * 1000000};
       nanosleep(&ts, nullptr);

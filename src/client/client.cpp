@@ -11,7 +11,7 @@
 #include <new>
 
 #include "common/platform.h"
-#include "config/config.h"
+#include "common/value_type.h"
 #include "store/segment.h"
 
 using ccomm::store::RingCursor;
@@ -26,8 +26,7 @@ namespace st = ccomm::store;
 // words of the cell per poll: it does not pull the writer's slot lines to its CPU, and
 // it holds the readers' line for as short a time as possible while the writer wants it.
 struct StateCache {
-  uint64_t version = 0;      // `latest` seen before the copy; 0 = none
-  uint64_t inline_seq = 0;   // small values: the inline copy's sequence seen before it
+  st::StateStamp stamp;      // the cell's stamp seen before the copy; version 0 = none
   SlotMeta meta;
   uint8_t* value = nullptr;  // value_bytes; null for event signals
 };
@@ -62,10 +61,19 @@ struct ccomm_client {
 
 namespace {
 
+// The public type codes are the store's and the wire's (common/value_type.h).
+static_assert(CCOMM_BOOL == static_cast<int>(ccomm::ValueType::kBool) &&
+                  CCOMM_INT32 == static_cast<int>(ccomm::ValueType::kInt32) &&
+                  CCOMM_UINT32 == static_cast<int>(ccomm::ValueType::kUint32) &&
+                  CCOMM_INT64 == static_cast<int>(ccomm::ValueType::kInt64) &&
+                  CCOMM_FLOAT == static_cast<int>(ccomm::ValueType::kFloat) &&
+                  CCOMM_DOUBLE == static_cast<int>(ccomm::ValueType::kDouble),
+              "ccomm_type must match common/value_type.h");
+
 // A signal's change counter: `latest` of a state, `published` of an event ring.
 uint64_t ChangeCounter(const HandleSignal& h) {
-  if (h.flags & st::kSigEvent) return h.ring.ring->published.load(std::memory_order_seq_cst);
-  return h.state.cell->latest.load(std::memory_order_seq_cst);
+  if (h.flags & st::kSigEvent) return st::RingChangeCount(h.ring);
+  return st::StateChangeCount(h.state);
 }
 
 // Compares every signal's change counter with the last look and remembers the new
@@ -87,10 +95,8 @@ size_t CachedBytes(const SignalDirectoryEntry& d) { return (d.flags & st::kSigEv
 // the copy, the next read copies again.
 StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
   StateCache& k = h.cache;
-  const st::StateCell* cell = h.state.cell;
-  const uint64_t version = cell->latest.load(std::memory_order_acquire);
-  const uint64_t iseq = h.value_bytes <= st::kInlineValueBytes ? cell->inline_seq.load(std::memory_order_acquire) : 0;
-  if (version && version == k.version && iseq == k.inline_seq) {
+  const st::StateStamp stamp = st::StateStampOf(h.state);
+  if (stamp.version && stamp == k.stamp) {
     memcpy(value, k.value, h.value_bytes);
     *meta = k.meta;
     return StoreResult::kOk;
@@ -99,8 +105,7 @@ StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
   if (r == StoreResult::kOk) {
     memcpy(k.value, value, h.value_bytes);
     k.meta = *meta;
-    k.version = version;
-    k.inline_seq = iseq;
+    k.stamp = stamp;
   }
   return r;
 }
@@ -427,6 +432,63 @@ int ccomm_daemon_alive(const ccomm_client* c) {
   if (h->daemon_pid.load(std::memory_order_acquire) == 0) return 0;
   uint64_t hb = h->daemon_heartbeat_ns.load(std::memory_order_acquire);
   return ccomm::platform::MonotonicNs() - hb < 1000000000ull ? 1 : 0;
+}
+
+int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out) {
+  const HandleSignal* h = Sig(c, s);
+  if (!h || !out) return CCOMM_E_INVAL;
+  const st::SignalStats& ss = *h->stats;
+  out->writes = ss.writes.load(std::memory_order_relaxed);
+  out->write_errors = ss.write_errors.load(std::memory_order_relaxed);
+  out->tx = ss.tx.load(std::memory_order_relaxed);
+  out->coalesced = ss.coalesced.load(std::memory_order_relaxed);
+  out->rx = ss.rx.load(std::memory_order_relaxed);
+  out->lost = ss.lost.load(std::memory_order_relaxed);
+  out->overflow = ss.overflow.load(std::memory_order_relaxed);
+  out->stale_transitions = ss.stale_transitions.load(std::memory_order_relaxed);
+  const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
+  const uint64_t now = ccomm::platform::MonotonicNs();
+  out->last_rx_age_ns = last ? Age(now, last) : -1;
+  out->stale = (h->flags & st::kSigConsumedHere) && h->stale_ns &&
+               (!last || static_cast<uint64_t>(Age(now, last)) > h->stale_ns);
+  return 0;
+}
+
+int ccomm_node_count(const ccomm_client* c) { return c ? static_cast<int>(c->segment.node_count()) : CCOMM_E_INVAL; }
+
+int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out) {
+  if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= c->segment.node_count()) return CCOMM_E_INVAL;
+  const uint32_t n = static_cast<uint32_t>(node);
+  const st::PeerStats& ps = c->segment.peer(n);
+  out->name = c->segment.node_name(n);
+  out->is_self = n == c->segment.header()->node_id;
+  out->alive = ps.alive.load(std::memory_order_relaxed) ? 1 : 0;
+  out->frames_rx = ps.frames_rx.load(std::memory_order_relaxed);
+  out->frames_tx = ps.frames_tx.load(std::memory_order_relaxed);
+  out->frames_lost = ps.frames_lost.load(std::memory_order_relaxed);
+  out->frames_reordered = ps.frames_reordered.load(std::memory_order_relaxed);
+  out->heartbeats_rx = ps.heartbeats_rx.load(std::memory_order_relaxed);
+  out->down_transitions = ps.down_transitions.load(std::memory_order_relaxed);
+  const uint64_t last = ps.last_rx_ns.load(std::memory_order_relaxed);
+  out->last_rx_age_ns = last ? Age(ccomm::platform::MonotonicNs(), last) : -1;
+  return 0;
+}
+
+int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {
+  static const char* const kNames[] = {
+      "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",
+      "frames_unknown_sender", "frames_auth_failed", "frames_replayed", "frames_not_for_us",
+      "entries_unknown_signal", "entries_wrong_type", "send_errors",  "tx_wakeups",
+      "recv_errors",       "slots_reclaimed",    "socket_drops"};
+  static_assert(sizeof(kNames) / sizeof(kNames[0]) == st::kDaemonCounterCount, "one name per DaemonCounter");
+  if (!c || index < 0 || static_cast<uint32_t>(index) >= st::kDaemonCounterCount) return CCOMM_E_INVAL;
+  if (name) *name = kNames[index];
+  if (value) *value = c->segment.header()->daemon_counters[index].load(std::memory_order_relaxed);
+  return 0;
+}
+
+uint32_t ccomm_daemon_generation(const ccomm_client* c) {
+  return c ? c->segment.header()->generation.load(std::memory_order_relaxed) : 0;
 }
 
 }  // extern "C"

@@ -9,7 +9,8 @@
 #include "ccomm/ccomm.hpp"
 #include "common/platform.h"
 #include "store/segment.h"
-#include "store/test_config.h"
+#include "daemon/segment_builder.h"
+#include "testing/test_config.h"
 
 extern "C" {
 void* __libc_malloc(size_t);
@@ -56,7 +57,7 @@ TEST(ClientAlloc, ReadWriteFlushWaitAllocateNothing) {
   store::Segment seg;
   std::string err;
   bool adopted;
-  ASSERT_EQ(seg.CreateOrAdopt(cfg, 0, store::SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&seg, cfg, 0, store::SegmentName("a"), -1, &adopted, &err), 0);
   seg.header()->tx_sleeping.store(1);  // make writes take the FUTEX_WAKE path too
 
   Client plain("a"), batch("a", CCOMM_OPEN_BATCH);

@@ -13,7 +13,8 @@
 
 #include "store/segment.h"
 #include "common/platform.h"
-#include "store/test_config.h"
+#include "daemon/segment_builder.h"
+#include "testing/test_config.h"
 
 namespace ccomm {
 namespace {
@@ -40,8 +41,8 @@ class ClientTest : public ::testing::Test {
     cfg_ = TwoNodeConfig({pos, sp, arr, ev, local});
     std::string err;
     bool adopted;
-    ASSERT_EQ(seg_a_.CreateOrAdopt(cfg_, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;
-    ASSERT_EQ(seg_b_.CreateOrAdopt(cfg_, 1, store::SegmentName("b"), -1, &adopted, &err), 0) << err;
+    ASSERT_EQ(CreateOrAdoptSegment(&seg_a_, cfg_, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;
+    ASSERT_EQ(CreateOrAdoptSegment(&seg_b_, cfg_, 1, store::SegmentName("b"), -1, &adopted, &err), 0) << err;
   }
   void TearDown() override {
     platform::ShmUnlink(store::SegmentName("a").c_str());

@@ -62,37 +62,8 @@ void parse_error_handler(const char* what, void* where) {
 
 namespace ccomm {
 
-size_t ValueTypeSize(ValueType t) {
-  switch (t) {
-    case ValueType::kBool: return 1;
-    case ValueType::kInt32: return 4;
-    case ValueType::kUint32: return 4;
-    case ValueType::kInt64: return 8;
-    case ValueType::kFloat: return 4;
-    case ValueType::kDouble: return 8;
-  }
-  return 0;
-}
-
-const char* ValueTypeName(ValueType t) {
-  switch (t) {
-    case ValueType::kBool: return "bool";
-    case ValueType::kInt32: return "int32";
-    case ValueType::kUint32: return "uint32";
-    case ValueType::kInt64: return "int64";
-    case ValueType::kFloat: return "float";
-    case ValueType::kDouble: return "double";
-  }
-  return nullptr;
-}
-
-namespace {
-constexpr ValueType kAllTypes[] = {ValueType::kBool,  ValueType::kInt32, ValueType::kUint32,
-                                   ValueType::kInt64, ValueType::kFloat, ValueType::kDouble};
-}  // namespace
-
 bool ParseValueType(const std::string& name, ValueType* out) {
-  for (ValueType t : kAllTypes) {
+  for (ValueType t : kAllValueTypes) {
     if (name == ValueTypeName(t)) {
       *out = t;
       return true;
@@ -951,7 +922,7 @@ void Parser::SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs) {
                                        "> in <signal> (it has no child elements)");
 
   std::vector<std::string> type_names;
-  for (ValueType t : kAllTypes) type_names.emplace_back(ValueTypeName(t));
+  for (ValueType t : kAllValueTypes) type_names.emplace_back(ValueTypeName(t));
   if (const AttrValue* a = e.Get("type")) {
     if (!ParseValueType(a->value, &sig->type)) {
       Err(a->line, "unknown type " + Quote(a->value) + " (expected " + Join(type_names, ", ") + ")");

@@ -15,21 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "common/value_type.h"
+
 namespace ccomm {
 
-enum class ValueType : uint8_t {  // wire codes, see docs/protocol.md
-  kBool = 1,
-  kInt32 = 2,
-  kUint32 = 3,
-  kInt64 = 4,
-  kFloat = 5,
-  kDouble = 6,
-};
-
-/// Bytes of one element of `t` on the wire and in shared memory (bool = 1 byte).
-size_t ValueTypeSize(ValueType t);
-/// "bool", "int32", ... ; nullptr for an unknown code.
-const char* ValueTypeName(ValueType t);
 /// Parses a type name; false if unknown.
 bool ParseValueType(const std::string& name, ValueType* out);
 

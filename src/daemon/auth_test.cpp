@@ -20,7 +20,7 @@
 
 #include "common/platform.h"
 #include "daemon/daemon.h"
-#include "store/test_config.h"
+#include "testing/test_config.h"
 
 namespace ccomm {
 namespace {

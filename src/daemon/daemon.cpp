@@ -2,6 +2,7 @@
 // Start-up, supervision and shutdown of the forwarding engine (send/receive paths are
 // in tx_path.cpp and rx_path.cpp).
 #include "daemon/daemon.h"
+#include "daemon/segment_builder.h"
 
 #include <errno.h>
 #include <grp.h>
@@ -78,7 +79,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
   int gid = -1;
   if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
-  int r = segment_.CreateOrAdopt(cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
+  int r = CreateOrAdoptSegment(&segment_, cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
   for (uint32_t p = 0; p < m; ++p) segment_.peer(p).alive.store(0);  // a re-adopted segment's are stale
@@ -91,7 +92,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     const auto& d = segment_.dir(static_cast<uint32_t>(i));
     if ((d.flags & store::kSigEvent) && (d.flags & store::kSigForwarded)) {
       // Resume where the previous ccommd stopped: queued events are still sent.
-      fwd_cursors_[i].next = segment_.ring(static_cast<uint32_t>(i)).ring->fwd_cursor.load();
+      fwd_cursors_[i].next = store::RingForwardCursor(segment_.ring(static_cast<uint32_t>(i)));
     }
   }
 

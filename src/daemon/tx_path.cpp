@@ -68,15 +68,15 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
       if (store::RingRead(ring, &cur, tx_value_, &m, now) != store::StoreResult::kOk) break;
       AddEntry(id, d, wire::kEntryEvent, m, tx_value_, now);
     }
-    ring.ring->fwd_cursor.store(cur.next, std::memory_order_release);
+    store::SetRingForwardCursor(ring, cur.next);
     return;
   }
   store::StateView sv = segment_.state(id);
   uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
-  if (version == 0 || (!periodic && version == sv.cell->forwarded.load(std::memory_order_relaxed))) return;
+  if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
   if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) return;
-  sv.cell->forwarded.store(version, std::memory_order_relaxed);
+  store::MarkStateForwarded(sv, version);
   uint64_t& last = last_tx_seq_[id];
   if (!periodic && last && m.value_seq > last + 1)
     segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);

@@ -61,21 +61,21 @@ inline StoreResult RingWrite(const RingView& v, const void* value, uint64_t valu
       break;
   }
   SlotHeader* s = v.slot(h);
-  uint64_t prev = s->seq.load(std::memory_order_acquire);
-  if ((prev & 1) || prev > 2 * h ||
-      !s->seq.compare_exchange_strong(prev, 2 * h + 1, std::memory_order_acq_rel))
-    return StoreResult::kBusy;  // ticket h stays a hole; readers skip it after a timeout
-  s->owner.store((uint64_t{platform::ProcessId()} << 32) | (h & 0xffffffffu), std::memory_order_relaxed);
-  SeqlockWriterFence();
-  uint64_t vs = value_seq ? value_seq : h + 1;
-  s->value_seq.store(vs, kMetaStore);
-  s->source_time_ns.store(source_time_ns, kMetaStore);
-  s->local_time_ns.store(local_time_ns, kMetaStore);
-  StoreWords(reinterpret_cast<uint8_t*>(s + 1), value, v.value_bytes);
-  s->seq.store(2 * h + 2, std::memory_order_release);
+  if (!ClaimCopy(s, h)) return StoreResult::kBusy;  // ticket h stays a hole; readers skip it after a timeout
+  const SlotMeta meta{value_seq ? value_seq : h + 1, source_time_ns, local_time_ns};
+  PublishSlot(s, h, v.value_bytes, value, meta);
   v.ring->published.fetch_add(1, std::memory_order_seq_cst);  // ccomm_wait's change counter (rx_waiters)
-  if (seq_out) *seq_out = vs;
+  if (seq_out) *seq_out = meta.value_seq;
   return StoreResult::kOk;
+}
+
+/// Change counter for ccomm_wait(): seq_cst, ordered with SegmentHeader::rx_waiters.
+inline uint64_t RingChangeCount(const RingView& v) { return v.ring->published.load(std::memory_order_seq_cst); }
+
+/// ccommd's forwarding position (writers' backpressure is measured against it).
+inline uint64_t RingForwardCursor(const RingView& v) { return v.ring->fwd_cursor.load(std::memory_order_acquire); }
+inline void SetRingForwardCursor(const RingView& v, uint64_t next) {
+  v.ring->fwd_cursor.store(next, std::memory_order_release);
 }
 
 /// A reader's position in one ring.
@@ -108,12 +108,7 @@ inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMet
     const SlotHeader* s = v.slot(t);
     uint64_t s1 = s->seq.load(std::memory_order_acquire);
     if (s1 == 2 * t + 2) {
-      meta->value_seq = s->value_seq.load(kMetaLoad);
-      meta->source_time_ns = s->source_time_ns.load(kMetaLoad);
-      meta->local_time_ns = s->local_time_ns.load(kMetaLoad);
-      LoadWords(out, reinterpret_cast<const uint8_t*>(s + 1), v.value_bytes);
-      SeqlockReaderFence();
-      if (s->seq.load(std::memory_order_relaxed) == s1) {
+      if (ReadSlot(s, t, v.value_bytes, out, meta)) {
         c->next = t + 1;
         c->stuck_since = 0;
         return StoreResult::kOk;

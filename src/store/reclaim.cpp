@@ -32,10 +32,7 @@ void ForEachSlot(const Segment& s, Fn fn) {
 // as its writer would have, if its slot still holds it complete.
 void PublishDeadInlineWriter(const StateView& v, uint64_t t) {
   if (v.slot(t)->seq.load(std::memory_order_acquire) != 2 * t + 2) return;
-  uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
-  while (cur < t + 1 &&
-         !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst, std::memory_order_relaxed)) {
-  }
+  PublishLatest(v, t);
 }
 
 }  // namespace

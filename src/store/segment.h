@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// A node's shared-memory segment: created (or re-adopted) by ccommd from the
-// configuration, mapped by clients. See layout.h for the invariants.
+// A node's shared-memory segment: created (or re-adopted) by ccommd from an image it
+// builds from the configuration (daemon/segment_builder.h), mapped by clients. See
+// layout.h for the invariants. The store knows nothing of the configuration.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
-#include "config/config.h"
 #include "store/event_ring.h"
 #include "store/layout.h"
 #include "store/state_slot.h"
@@ -25,12 +25,13 @@ class Segment {
   Segment(const Segment&) = delete;
   Segment& operator=(const Segment&) = delete;
 
-  /// Daemon side. Re-adopts an existing segment with exactly the layout this
-  /// configuration produces (clients keep running across a daemon restart); otherwise
-  /// marks the old one retired, unlinks it and creates a fresh one (mode 0660, group
-  /// `gid` if >= 0). Returns 0 or -errno; `error` says what failed.
-  int CreateOrAdopt(const SystemConfig& cfg, uint32_t node_id, const std::string& name,
-                    int gid, bool* adopted, std::string* error);
+  /// Daemon side. `image` (`size` bytes, state kInitializing) is the complete segment as
+  /// the daemon built it. Re-adopts an existing segment with exactly that layout
+  /// (clients keep running across a daemon restart); otherwise marks the old one
+  /// retired, unlinks it and creates a fresh one from the image (mode 0660, group `gid`
+  /// if >= 0). Returns 0 or -errno; `error` says what failed.
+  int CreateOrAdopt(const void* image, size_t size, const std::string& name, int gid, bool* adopted,
+                    std::string* error);
 
   /// Client side: maps an existing, ready segment. Returns 0, -ENOENT (no segment or
   /// not ready yet), -EPROTO (bad magic/layout version/size) or another -errno.
@@ -82,11 +83,6 @@ class Segment {
   void* base_ = nullptr;
   size_t size_ = 0;
 };
-
-/// Builds the complete segment image for `cfg` as seen by `node_id` into `mem`
-/// (size from SegmentSize). Used for creation and to compare with an existing segment.
-size_t SegmentSize(const SystemConfig& cfg);
-void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size);
 
 }  // namespace store
 }  // namespace ccomm

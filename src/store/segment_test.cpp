@@ -11,7 +11,8 @@
 #include "store/reclaim.h"
 #include <sys/wait.h>
 #include <unistd.h>
-#include "store/test_config.h"
+#include "daemon/segment_builder.h"
+#include "testing/test_config.h"
 
 namespace ccomm {
 namespace store {
@@ -40,7 +41,7 @@ TEST_F(SegmentTest, CreateThenOpenSeesDirectory) {
   Segment d;
   bool adopted = true;
   std::string err;
-  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+  ASSERT_EQ(CreateOrAdoptSegment(&d, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
   EXPECT_FALSE(adopted);
   Segment c;
   ASSERT_EQ(c.Open(SegmentName("a")), 0);
@@ -63,13 +64,13 @@ TEST_F(SegmentTest, RestartAdoptsAndKeepsValues) {
   Segment client;
   {
     Segment d;
-    ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+    ASSERT_EQ(CreateOrAdoptSegment(&d, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
     ASSERT_EQ(client.Open(SegmentName("a")), 0);
     double v = 4.25;
     ASSERT_EQ(StateWrite(client.state(0), &v, 0, 1, 1), StoreResult::kOk);
   }  // daemon gone
   Segment d2;
-  ASSERT_EQ(d2.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&d2, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
   EXPECT_TRUE(adopted);
   EXPECT_EQ(d2.header()->generation.load(), 2u);
   double out = 0;
@@ -84,13 +85,13 @@ TEST_F(SegmentTest, ConfigChangeRetiresOldSegment) {
   std::string err;
   bool adopted;
   Segment d, client;
-  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&d, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
   ASSERT_EQ(client.Open(SegmentName("a")), 0);
   SystemConfig changed = cfg;
   changed.signals[1].count = 4;
   changed.hash += 1;
   Segment d2;
-  ASSERT_EQ(d2.CreateOrAdopt(changed, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&d2, changed, 0, SegmentName("a"), -1, &adopted, &err), 0);
   EXPECT_FALSE(adopted);
   EXPECT_EQ(client.header()->state.load(), kRetired);
   Segment fresh;
@@ -120,7 +121,7 @@ TEST_F(SegmentTest, OpenMissingOrForeignSegment) {
   Segment d;
   std::string err;
   bool adopted;
-  ASSERT_EQ(d.CreateOrAdopt(Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+  ASSERT_EQ(CreateOrAdoptSegment(&d, Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
   EXPECT_EQ(c.Open(SegmentName("a")), 0);
 }
 
@@ -130,7 +131,7 @@ TEST_F(SegmentTest, ReclaimFreesDeadWritersSlotsOnly) {
   Segment d;
   std::string err;
   bool adopted;
-  ASSERT_EQ(d.CreateOrAdopt(cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&d, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0);
   std::vector<SlotSuspect> suspects(SlotCount(d));
   EXPECT_EQ(SlotCount(d), (4u + 1u) + (4u + 1u) + 16u);  // states: 4 slots + the inline copy
   // A child claims a slot like a writer and dies before completing it.
@@ -173,7 +174,7 @@ TEST_F(SegmentTest, ReclaimPublishesADeadInlineWritersValue) {
   Segment d;
   std::string err;
   bool adopted;
-  ASSERT_EQ(d.CreateOrAdopt(Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0);
+  ASSERT_EQ(CreateOrAdoptSegment(&d, Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0);
   std::vector<SlotSuspect> suspects(SlotCount(d));
   StateView v = d.state(0);  // "pos", one double
   double x = 1.0;
@@ -188,7 +189,7 @@ TEST_F(SegmentTest, ReclaimPublishesADeadInlineWritersValue) {
     StoreWords(reinterpret_cast<uint8_t*>(h + 1), &y, 8);
     h->seq.store(2 * t + 2);
     ASSERT_TRUE(ClaimInline(v, t));
-    FillInline(v, t, t + 1, 2, 2, &y);
+    FillInline(v, t, SlotMeta{t + 1, 2, 2}, &y);
     _exit(0);
   }
   waitpid(child, nullptr, 0);

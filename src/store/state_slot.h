@@ -30,16 +30,10 @@
 
 #include "common/platform.h"
 #include "store/layout.h"
-#include "store/word_copy.h"
+#include "store/seqlock.h"
 
 namespace ccomm {
 namespace store {
-
-struct SlotMeta {
-  uint64_t value_seq = 0;
-  uint64_t source_time_ns = 0;
-  uint64_t local_time_ns = 0;
-};
 
 struct StateView {
   StateCell* cell = nullptr;
@@ -59,43 +53,28 @@ enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull };
 /// claim lives on line 1; the holder fills line 0 with plain stores (FillInline),
 /// publishes `latest` and only then releases the claim (ReleaseInline), so the inline
 /// copy is never older than `latest - 1` while it is complete (see StateRead).
-inline bool ClaimInline(const StateView& v, uint64_t t) {
-  SlotHeader* claim = &v.cell->inline_claim;
-  uint64_t s = claim->seq.load(std::memory_order_relaxed);
-  if ((s & 1) || s > 2 * t || !claim->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel))
-    return false;
-  claim->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
-  return true;
-}
+inline bool ClaimInline(const StateView& v, uint64_t t) { return ClaimCopy(&v.cell->inline_claim, t); }
 
-inline void FillInline(const StateView& v, uint64_t t, uint64_t value_seq, uint64_t source_time_ns,
-                       uint64_t local_time_ns, const void* value) {
+/// Fills the inline copy (the caller holds the inline claim for ticket t).
+inline void FillInline(const StateView& v, uint64_t t, const SlotMeta& meta, const void* value) {
   StateCell* c = v.cell;
   c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
-  SeqlockWriterFence();
-  c->inline_meta[0].store(value_seq, kMetaStore);
-  c->inline_meta[1].store(source_time_ns, kMetaStore);
-  c->inline_meta[2].store(local_time_ns, kMetaStore);
-  StoreWords(reinterpret_cast<uint8_t*>(c->inline_value), value, v.value_bytes);
-  c->inline_seq.store(2 * t + 2, std::memory_order_release);
+  StampAndPublish(&c->inline_seq, c->inline_meta, reinterpret_cast<uint8_t*>(c->inline_value), t, v.value_bytes,
+                  value, meta);
 }
 
 inline void ReleaseInline(const StateView& v, uint64_t t) {
   v.cell->inline_claim.seq.store(2 * t + 2, std::memory_order_release);
 }
 
-/// Copies a seqlocked value (seq word, the three meta words, the value) if it holds
-/// complete ticket t.
-inline bool ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta3, const uint8_t* data,
-                     uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
-  uint64_t s1 = seq->load(std::memory_order_acquire);
-  if (s1 != 2 * t + 2) return false;
-  meta->value_seq = meta3[0].load(kMetaLoad);
-  meta->source_time_ns = meta3[1].load(kMetaLoad);
-  meta->local_time_ns = meta3[2].load(kMetaLoad);
-  LoadWords(out, data, value_bytes);
-  SeqlockReaderFence();
-  return seq->load(std::memory_order_relaxed) == s1;
+/// Raises `latest` to t+1 unless a newer copy is already published. Each failed CAS
+/// means another writer published, so this ends within #writers tries. seq_cst: see
+/// SegmentHeader::rx_waiters.
+inline void PublishLatest(const StateView& v, uint64_t t) {
+  uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
+  while (cur < t + 1 &&
+         !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst, std::memory_order_relaxed)) {
+  }
 }
 
 /// Writes a value. value_seq == 0 means "number it": the ticket + 1 is used.
@@ -108,28 +87,14 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
     if (latest != 0 && (latest - 1) % kStateSlots == t % kStateSlots) continue;  // newest copy
     SlotHeader* h = v.slot(t);
-    uint64_t s = h->seq.load(std::memory_order_relaxed);
-    if ((s & 1) || s > 2 * t) continue;  // being written (or its writer died), or newer
-    if (!h->seq.compare_exchange_strong(s, 2 * t + 1, std::memory_order_acq_rel)) continue;
-    h->owner.store((uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu), std::memory_order_relaxed);
-    SeqlockWriterFence();
-    uint64_t vs = value_seq ? value_seq : t + 1;
-    h->value_seq.store(vs, kMetaStore);
-    h->source_time_ns.store(source_time_ns, kMetaStore);
-    h->local_time_ns.store(local_time_ns, kMetaStore);
-    StoreWords(reinterpret_cast<uint8_t*>(h + 1), value, v.value_bytes);
-    h->seq.store(2 * t + 2, std::memory_order_release);
+    if (!ClaimCopy(h, t)) continue;  // being written (or its writer died), or newer
+    const SlotMeta meta{value_seq ? value_seq : t + 1, source_time_ns, local_time_ns};
+    PublishSlot(h, t, v.value_bytes, value, meta);
     const bool inl = v.value_bytes <= kInlineValueBytes && ClaimInline(v, t);
-    if (inl) FillInline(v, t, vs, source_time_ns, local_time_ns, value);
-    // Publish: raise latest to t+1 unless a newer copy is already published. Each
-    // failed CAS means another writer published, so this ends within #writers tries.
-    uint64_t cur = v.cell->latest.load(std::memory_order_relaxed);
-    while (cur < t + 1 &&
-           !v.cell->latest.compare_exchange_weak(cur, t + 1, std::memory_order_seq_cst,  // see rx_waiters
-                                                 std::memory_order_relaxed)) {
-    }
+    if (inl) FillInline(v, t, meta, value);
+    PublishLatest(v, t);
     if (inl) ReleaseInline(v, t);
-    if (seq_out) *seq_out = vs;
+    if (seq_out) *seq_out = meta.value_seq;
     return StoreResult::kOk;
   }
   return StoreResult::kBusy;
@@ -155,9 +120,7 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
         continue;  // refilled while we copied
       }
     }
-    const SlotHeader* h = v.slot(t);
-    if (ReadCopy(&h->seq, &h->value_seq, reinterpret_cast<const uint8_t*>(h + 1), t, v.value_bytes, out, meta))
-      return StoreResult::kOk;
+    if (ReadSlot(v.slot(t), t, v.value_bytes, out, meta)) return StoreResult::kOk;
   }
   return StoreResult::kBusy;
 }
@@ -165,6 +128,30 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
 /// `latest` counter: changes whenever a new value is published (cheap change check).
 inline uint64_t StateVersion(const StateView& v) {
   return v.cell->latest.load(std::memory_order_acquire);
+}
+
+/// What a reader's cached copy of a state was taken at: `latest` and, for small values,
+/// the inline copy's sequence word (it can move ahead of `latest`, see StateRead). Both
+/// unchanged means the cached copy is still the newest value.
+struct StateStamp {
+  uint64_t version = 0;
+  uint64_t inline_seq = 0;
+  bool operator==(const StateStamp& o) const { return version == o.version && inline_seq == o.inline_seq; }
+};
+inline StateStamp StateStampOf(const StateView& v) {
+  StateStamp s;
+  s.version = v.cell->latest.load(std::memory_order_acquire);
+  s.inline_seq = v.value_bytes <= kInlineValueBytes ? v.cell->inline_seq.load(std::memory_order_acquire) : 0;
+  return s;
+}
+
+/// Change counter for ccomm_wait(): seq_cst, ordered with SegmentHeader::rx_waiters.
+inline uint64_t StateChangeCount(const StateView& v) { return v.cell->latest.load(std::memory_order_seq_cst); }
+
+/// ccommd's forwarding mark: the `latest` it last sent (the cell's forwarder line).
+inline uint64_t StateForwarded(const StateView& v) { return v.cell->forwarded.load(std::memory_order_relaxed); }
+inline void MarkStateForwarded(const StateView& v, uint64_t version) {
+  v.cell->forwarded.store(version, std::memory_order_relaxed);
 }
 
 }  // namespace store

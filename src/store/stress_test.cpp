@@ -15,7 +15,8 @@
 #include "common/platform.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
-#include "store/test_config.h"
+#include "daemon/segment_builder.h"
+#include "testing/test_config.h"
 
 namespace ccomm {
 namespace store {
@@ -74,7 +75,7 @@ TEST(Stress, WritersKilledAtRandomNeverCorruptReaders) {
   Segment seg;
   std::string err, name = SegmentName("a");
   bool adopted;
-  ASSERT_EQ(seg.CreateOrAdopt(cfg, 0, name, -1, &adopted, &err), 0) << err;
+  ASSERT_EQ(CreateOrAdoptSegment(&seg, cfg, 0, name, -1, &adopted, &err), 0) << err;
 
   const double seconds = getenv("CCOMM_STRESS_SECONDS") ? atof(getenv("CCOMM_STRESS_SECONDS")) : 3.0;
   const uint64_t until = platform::MonotonicNs() + static_cast<uint64_t>(seconds * 1e9);

@@ -6,6 +6,8 @@
 // access is checked against the buffer bounds before it happens.
 #include "wire/wire.h"
 
+#include "common/value_type.h"
+
 #include <cstring>
 
 namespace ccomm {
@@ -44,18 +46,7 @@ constexpr size_t kEOffSignal = 0, kEOffType = 2, kEOffFlags = 3, kEOffCount = 4,
 
 constexpr uint8_t kKnownFrameFlags = kFlagHeartbeat | kFlagAuth;
 constexpr uint8_t kKnownEntryFlags = kEntryEvent;
-constexpr uint8_t kTypeBool = 1;
-
-// Element size of a wire type code, 0 if unknown. The codes match ccomm::ValueType;
-// wire does not depend on the config module.
-inline size_t ElementSize(uint8_t type) {
-  switch (type) {
-    case 1: return 1;             // bool
-    case 2: case 3: case 5: return 4;  // int32, uint32, float
-    case 4: case 6: return 8;     // int64, double
-    default: return 0;
-  }
-}
+constexpr uint8_t kTypeBool = static_cast<uint8_t>(ValueType::kBool);
 
 inline size_t Padded(size_t n) { return (n + 7u) & ~size_t{7}; }
 
@@ -72,7 +63,7 @@ inline size_t DeclaredLength(const uint8_t* buf) {
 DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
   if (left < kEntryHeaderSize) return DecodeError::kBadEntry;
   const uint8_t type = p[kEOffType];
-  const size_t esize = ElementSize(type);
+  const size_t esize = ValueTypeSize(type);
   if (esize == 0) return DecodeError::kBadEntry;
   if (p[kEOffFlags] & ~kKnownEntryFlags) return DecodeError::kBadEntry;
   const size_t count = Load<uint16_t>(p + kEOffCount);
@@ -135,7 +126,7 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   if (len_ < kHeaderSize) return false;                 // no successful Begin
   if (buf_[kOffFlags] & kFlagHeartbeat) return false;  // heartbeats carry no entries
   if (count_ == UINT16_MAX) return false;
-  const size_t esize = ElementSize(type);
+  const size_t esize = ValueTypeSize(type);
   if (esize == 0 || count == 0 || value_len != size_t{count} * esize) return false;
   if ((flags & ~kKnownEntryFlags) != 0 || value == nullptr) return false;
   // limit_ <= kMaxFrameSize, so value_len and the sizes below stay far from overflow
@@ -258,7 +249,7 @@ bool EntryIterator::Next(EntryView* e) {
 
 void ValueToHost(uint8_t type, const uint8_t* src, void* dst, size_t count) {
   uint8_t* d = static_cast<uint8_t*>(dst);
-  switch (ElementSize(type)) {
+  switch (ValueTypeSize(type)) {
     case 1:
       std::memcpy(d, src, count);
       break;

@@ -175,6 +175,54 @@ CCOMM_API int ccomm_wait(ccomm_client* c, int timeout_ms);
 /** 1 if ccommd updated its heartbeat in the segment within the last second, else 0. */
 CCOMM_API int ccomm_daemon_alive(const ccomm_client* c);
 
+/*
+ * Introspection: the counters ccommd and the clients keep for this node (what
+ * `ccomm stats` shows). For tools and monitoring; not real-time calls (they read many
+ * words), but they never block and never allocate. Counters only grow.
+ */
+
+/** Counters of one signal on this node. */
+typedef struct ccomm_signal_stats {
+  uint64_t writes;            /**< local writes accepted */
+  uint64_t write_errors;      /**< local writes refused (full, busy) */
+  uint64_t tx;                /**< values ccommd sent */
+  uint64_t coalesced;         /**< values replaced by a newer one before ccommd sent them */
+  uint64_t rx;                /**< values ccommd received */
+  uint64_t lost;              /**< gaps in the producer's sequence seen by ccommd */
+  uint64_t overflow;          /**< events readers lost to ring overrun */
+  uint64_t stale_transitions; /**< fresh -> stale seen by ccommd's supervision */
+  int64_t last_rx_age_ns;     /**< age of the last received value; -1 if none */
+  int32_t stale;              /**< consumed here with stale_after_ms, and older than that (or never) */
+} ccomm_signal_stats;
+/** Fills `out`; CCOMM_E_INVAL for a bad handle or signal. */
+CCOMM_API int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out);
+
+/** Number of nodes in the system (node indexes are 0..n-1, in signals.xml order). */
+CCOMM_API int ccomm_node_count(const ccomm_client* c);
+
+/** What this node's ccommd knows of node `node` (frames from and to it). */
+typedef struct ccomm_peer_stats {
+  const char* name;           /**< points into the segment; valid until ccomm_close */
+  int32_t is_self;            /**< 1 for the node this handle is attached to (counters 0) */
+  int32_t alive;              /**< 1 while its heartbeats arrive within peer_timeout_ms */
+  uint64_t frames_rx, frames_tx;
+  uint64_t frames_lost;       /**< gaps in its frame sequence */
+  uint64_t frames_reordered;  /**< frames older than expected (duplicates, reordering) */
+  uint64_t heartbeats_rx;
+  uint64_t down_transitions;  /**< alive -> lost */
+  int64_t last_rx_age_ns;     /**< -1 if nothing was received from it */
+} ccomm_peer_stats;
+/** Fills `out`; CCOMM_E_INVAL for a bad handle or node index. */
+CCOMM_API int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out);
+
+/**
+ * Daemon-wide counter `index` (0, 1, ... until CCOMM_E_INVAL): its name (e.g.
+ * "frames_bad", see ccomm(1)) and value. `name` or `value` may be NULL.
+ */
+CCOMM_API int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value);
+/** How many times a ccommd created or re-adopted this node's segment (1 = first start). */
+CCOMM_API uint32_t ccomm_daemon_generation(const ccomm_client* c);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: Apache-2.0
+// Builds a node's shared-memory segment image from the configuration: the daemon's job
+// (clients only map segments, the store only knows their layout).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "config/config.h"
+#include "store/segment.h"
+
+namespace ccomm {
+
+/// Bytes of the segment `cfg` gives every node (whole pages).
+size_t SegmentSize(const SystemConfig& cfg);
+/// Builds the complete segment image for `cfg` as seen by `node_id` into `mem` (size
+/// from SegmentSize). Used for creation and to compare with an existing segment.
+void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size);
+/// Builds the image and creates or re-adopts the segment `name` from it (see
+/// store::Segment::CreateOrAdopt).
+int CreateOrAdoptSegment(store::Segment* segment, const SystemConfig& cfg, uint32_t node_id,
+                         const std::string& name, int gid, bool* adopted, std::string* error);
+
+}  // namespace ccomm

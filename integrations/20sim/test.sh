@@ -4,6 +4,9 @@
 #   - the C-code target: the example controller generated from its tokens file, run as a
 #     periodic task, checked as a closed loop by pd_check (also with --param kp=4),
 #     plus start-up failures for unmapped ports and unknown parameters;
+#   - the step order: a model with a derivative kick, states and a matrix, generated for
+#     Discrete, Euler, RungeKutta2 and RungeKutta4, sample by sample against a reference
+#     of 20-sim's documented order (test/step_order.py); the template language;
 #   - the 4C component: generated from signals.xml, run by the 4C harness, same checks.
 # Usage: test.sh CCOMM_BIN_DIR [INTEGRATION_BIN_DIR]  (ccommd/ccomm, then the built tests)
 set -euo pipefail
@@ -93,6 +96,14 @@ if python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --ta
     --tokens <(sed 's/\[CDATA\[Euler\]\]/[CDATA[BDF]]/' "$here/example/PDController_tokens.xml") \
     --out "$out/gen_bdf" 2>"$out/e4"; then echo "FAIL unsupported method accepted"; fail=1;
 else echo "PASS unsupported method refused: $(cat "$out/e4")"; fi
+
+echo "== 20-sim C-code target: step order and integration methods against 20-sim's documented order"
+# StepOrder: derivative kick, two states, a gain matrix; sample by sample, all four methods.
+if python3 "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" \
+     --ccomm-include "$here/../../src/include" --ccomm-lib "$(cd "$bin/../lib" && pwd)"; then :; else fail=1; fi
+
+echo "== 20-sim C-code target: template language (%IF% with EQ/NEQ/NOT/AND/OR, undefined tokens)"
+if python3 "$here/test/tokensubst_check.py"; then :; else fail=1; fi
 
 echo "== 20-sim C-code target: the generated project builds with its own CMakeLists.txt"
 python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \

@@ -12,10 +12,14 @@ script repeats that replacement without 20-sim, so that:
     tokensubst.py --targets Targets.ini --target ccomm --tokens PD_tokens.xml --out DIR
 
 Supported: %NAME% for every token in the tokens file and every %NAME%=value line of the
-target section; %IF%%COND%, %ELSE%, %ENDIF% (nested), with COND one of NAME, a number,
-NOT(NAME), AND(A,B), OR(A,B). A COND is true when its value is a non-zero number or a
-non-empty string other than XXFALSE. The newline right after %IF%%COND%, %ELSE% and
-%ENDIF% is dropped, as 20-sim does.
+target section; %IF%%COND%, %ELSE%, %ENDIF% (nested), with COND as 20-sim's templates
+write it: NAME, a number, NOT(C), AND(C,C,...), OR(C,C,...), EQ(A,B), NEQ(A,B) (also NE),
+nested (NOT(EQ(INTEGRATION_METHOD_NAME,MeBDFi))). EQ/NEQ compare the values of A and B,
+where an argument that is not a token is its own text (EQ(FMIVERSION,2.0)); numbers
+compare as numbers. A COND is true when its value is a non-zero number or a non-empty
+string other than XXFALSE/FALSE; a token the model does not define is false (templates
+test %IF%%FMI1% in targets that never define FMI1). The newline right after
+%IF%%COND%, %ELSE% and %ENDIF% is dropped, as 20-sim does.
 """
 from __future__ import annotations
 
@@ -107,7 +111,7 @@ def read_tokens(path: Path) -> dict[str, str]:
 
 def truthy(value: str) -> bool:
     v = value.strip()
-    if not v or v.upper() == "XXFALSE":
+    if not v or v.upper() in ("XXFALSE", "FALSE"):
         return False
     try:
         return float(v) != 0.0
@@ -115,22 +119,74 @@ def truthy(value: str) -> bool:
         return True
 
 
-def eval_cond(cond: str, tokens: dict[str, str]) -> bool:
-    m = re.fullmatch(r"(NOT|AND|OR)\((.*)\)", cond)
-    if m:
-        args = [a.strip() for a in m.group(2).split(",")]
-        vals = [eval_cond(a, tokens) for a in args]
-        if m.group(1) == "NOT":
+def split_args(text: str, where: str) -> list[str]:
+    """Splits "A, EQ(B,C)" at the top-level commas."""
+    args, depth, cur = [], 0, []
+    for ch in text:
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth -= 1
+            if depth < 0:
+                raise TemplateError(f"{where}: unbalanced ')' in %IF% condition")
+        if ch == "," and depth == 0:
+            args.append("".join(cur).strip())
+            cur = []
+        else:
+            cur.append(ch)
+    if depth != 0:
+        raise TemplateError(f"{where}: unbalanced '(' in %IF% condition")
+    args.append("".join(cur).strip())
+    return args
+
+
+def operand(arg: str, tokens: dict[str, str]) -> str:
+    """An EQ/NEQ argument: a token's value, else the text itself."""
+    return tokens[arg].strip() if arg in tokens else arg
+
+
+def same_value(a: str, b: str) -> bool:
+    try:
+        return float(a) == float(b)
+    except ValueError:
+        return a == b
+
+
+FUNC_RE = re.compile(r"([A-Z]+)\((.*)\)", re.S)
+ARITY = {"NOT": (1, 1), "AND": (2, 99), "OR": (2, 99), "EQ": (2, 2), "NEQ": (2, 2), "NE": (2, 2)}
+
+
+def eval_cond(cond: str, tokens: dict[str, str], where: str = "template") -> bool:
+    cond = cond.strip()
+    m = FUNC_RE.fullmatch(cond)
+    if m and m.group(1) in ARITY:
+        name = m.group(1)
+        args = split_args(m.group(2), where)
+        lo, hi = ARITY[name]
+        if not lo <= len(args) <= hi or any(not a for a in args):
+            raise TemplateError(f"{where}: %IF%%{cond}%: {name} takes "
+                                f"{lo if lo == hi else f'{lo} or more'} argument(s)")
+        if name in ("EQ", "NEQ", "NE"):
+            equal = same_value(operand(args[0], tokens), operand(args[1], tokens))
+            return equal if name == "EQ" else not equal
+        vals = [eval_cond(a, tokens, where) for a in args]
+        if name == "NOT":
             return not vals[0]
-        return all(vals) if m.group(1) == "AND" else any(vals)
+        return all(vals) if name == "AND" else any(vals)
+    if m:
+        raise TemplateError(f"{where}: %IF%%{cond}%: unknown function {m.group(1)} "
+                            f"(known: {', '.join(sorted(ARITY))})")
     if re.fullmatch(r"-?[0-9.]+", cond):
         return truthy(cond)
-    if cond not in tokens:
-        raise TemplateError(f"%IF% on unknown token {cond}")
-    return truthy(tokens[cond])
+    if "(" in cond or ")" in cond:
+        raise TemplateError(f"{where}: %IF%%{cond}%: unbalanced parentheses")
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", cond):
+        raise TemplateError(f"{where}: %IF%%{cond}%: not a token name, number or function")
+    return truthy(tokens.get(cond, ""))
 
 
-COND_RE = re.compile(r"%IF%%([A-Z0-9_]+(?:\([A-Z0-9_, ]*\))?|-?[0-9.]+)%\n?|%ELSE%\n?|%ENDIF%\n?")
+# %IF%%COND%: COND is anything up to the next '%' (20-sim's conditions hold no '%').
+COND_RE = re.compile(r"%IF%%([^%\n]+)%\n?|%ELSE%\n?|%ENDIF%\n?")
 
 
 def expand_conditionals(text: str, tokens: dict[str, str], where: str) -> str:
@@ -143,22 +199,23 @@ def expand_conditionals(text: str, tokens: dict[str, str], where: str) -> str:
             out.append(text[pos:m.start()])
         pos = m.end()
         tag = m.group(0).rstrip("\n")
+        line = text.count("\n", 0, m.start()) + 1
         if tag.startswith("%IF%"):
-            branch = active and eval_cond(m.group(1), tokens)
+            branch = active and eval_cond(m.group(1), tokens, f"{where}:{line}")
             stack.append((active, branch))
             active = branch
         elif tag == "%ELSE%":
             if not stack:
-                raise TemplateError(f"{where}: %ELSE% without %IF%")
+                raise TemplateError(f"{where}:{line}: %ELSE% without %IF%")
             parent, branch = stack[-1]
             stack[-1] = (parent, parent and not branch)
             active = parent and not branch
         else:
             if not stack:
-                raise TemplateError(f"{where}: %ENDIF% without %IF%")
+                raise TemplateError(f"{where}:{line}: %ENDIF% without %IF%")
             active = stack.pop()[0]
     if stack:
-        raise TemplateError(f"{where}: %IF% without %ENDIF%")
+        raise TemplateError(f"{where}: {len(stack)} %IF% without %ENDIF% at the end of the file")
     if active:
         out.append(text[pos:])
     return "".join(out)

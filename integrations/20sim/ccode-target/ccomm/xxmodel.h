@@ -11,10 +11,6 @@
 
 #include "xxtypes.h"
 
-%IF%%NUMBER_MATRICES%
-#error "ccomm target: this submodel uses matrices, which the ccomm target does not support yet"
-%ENDIF%
-
 /* The integration method chosen in the 20-sim simulator settings. */
 #define %INTEGRATION_METHOD_NAME%_METHOD
 
@@ -25,6 +21,7 @@
 #define XX_NUMBER_STATES %NUMBER_STATES%
 #define XX_NUMBER_INPUTS %NUMBER_INPUTS%
 #define XX_NUMBER_OUTPUTS %NUMBER_OUTPUTS%
+#define XX_NUMBER_MATRICES %NUMBER_MATRICES%
 #define XX_TIME_STEP_SIZE %TIME_STEP_SIZE%
 #define XX_START_TIME %START_TIME%
 #define XX_FINISH_TIME %FINISH_TIME%
@@ -44,6 +41,7 @@ extern XXDouble %VARPREFIX%%XX_VARIABLE_ARRAY_NAME%[];
 extern XXDouble %VARPREFIX%%XX_STATE_ARRAY_NAME%[];
 extern XXDouble %VARPREFIX%%XX_RATE_ARRAY_NAME%[];
 extern XXDouble %VARPREFIX%%XX_UNNAMED_ARRAY_NAME%[];
+extern XXMatrix %VARPREFIX%%XX_MATRIX_ARRAY_NAME%[]; /* views into the arrays above (xxmatrix.h) */
 extern XXDouble %VARPREFIX%%XX_FAVORITE_PARS_ARRAY_NAME%[];
 extern XXDouble %VARPREFIX%%XX_FAVORITE_VARS_ARRAY_NAME%[];
 extern XXDouble %VARPREFIX%%XX_EXT_IN_ARRAY_NAME%[];

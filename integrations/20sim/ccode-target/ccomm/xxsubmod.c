@@ -17,6 +17,16 @@ static void XXCopyVariablesToOutputs(XXDouble* y) {
 %VARIABLE_TO_OUTPUT_EQUATIONS%
 }
 
+/* 20-sim's submodel protocol, which every generated target follows so that the code
+ * computes the sample sequence 20-sim's simulator computes:
+ *   initialize: initial, static, input, dynamic, output equations once at t0, so the
+ *               first outputs and the rates of the first step exist;
+ *   each step:  inputs -> input equations -> integration step (advances the states with
+ *               the rates evaluated at the end of the previous step, then evaluates the
+ *               dynamic equations at the new time with this step's inputs) -> output
+ *               equations -> outputs.
+ * The rates of a step are those of the previous sample: evaluating the dynamic equations
+ * again before the step would integrate this step's inputs one sample early. */
 void %FUNCTIONPREFIX%InitializeSubmodel(XXDouble* u, XXDouble* y, XXDouble t) {
   %VARPREFIX%%XX_TIME% = t;
   %VARPREFIX%step_size = %TIME_STEP_SIZE%;
@@ -37,15 +47,14 @@ void %FUNCTIONPREFIX%InitializeSubmodel(XXDouble* u, XXDouble* y, XXDouble t) {
   %VARPREFIX%%XX_INITIALIZE% = XXFALSE;
 }
 
-/* One period: y = outputs after advancing the model from t to t + step with inputs u. */
+/* One period: y = outputs at t + step, after advancing the model from t with inputs u. */
 void %FUNCTIONPREFIX%CalculateSubmodel(XXDouble* u, XXDouble* y, XXDouble t) {
   %VARPREFIX%%XX_TIME% = t;
   XXCopyInputsToVariables(u);
-  /* Parameters may have been changed between steps (runner --param or a monitor). */
+  /* Static equations depend on parameters only: recomputing them each step is what
+   * 20-sim does after a parameter change and changes nothing otherwise. */
   %FUNCTIONPREFIX%CalculateStatic();
   %FUNCTIONPREFIX%CalculateInput();
-  /* Rates for the current inputs before integrating (inputs changed since last step). */
-  %FUNCTIONPREFIX%CalculateDynamic();
   %FUNCTIONPREFIX%%INTEGRATION_METHOD_NAME%Step();
   %FUNCTIONPREFIX%CalculateOutput();
   XXCopyVariablesToOutputs(y);

@@ -14,7 +14,8 @@ typedef char XXCharacter;
 typedef char XXBoolean;
 typedef const char* XXString;
 
-/* Matrix descriptor (the ccomm target rejects models with matrices, see xxmodel.h). */
+/* A matrix: a row-major view into the model arrays (mat[row * columns + column]);
+ * 20-sim sets mat, rows and columns in ModelInitialize. Helpers: xxmatrix.h. */
 typedef struct {
   XXDouble* mat;
   XXInteger rows;

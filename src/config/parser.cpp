@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "config/parser.h"
+
+#include <cstring>
+
+namespace ccomm {
+namespace config_detail {
+
+// Reports text inside an element (everything in this format is an attribute).
+void CheckNoText(const Node* parent, Diagnostics* diag) {
+  for (const Node* c = parent->first_node(); c; c = c->next_sibling()) {
+    if (c->type() != rapidxml::node_data && c->type() != rapidxml::node_cdata) continue;
+    std::string_view v(c->value(), c->value_size());
+    size_t first = v.find_first_not_of(" \t\r\n");
+    if (first == std::string_view::npos) continue;
+    std::string_view shown = v.substr(first, 20);
+    size_t nl = shown.find_first_of("\r\n");
+    if (nl != std::string_view::npos) shown = shown.substr(0, nl);
+    diag->Error(diag->LineOf(c->value() + first),
+                "unexpected text " + Quote(shown) + " inside <" + std::string(NameOf(parent)) +
+                    "> (settings go in attributes)");
+  }
+}
+bool Parser::Name(const Element& e, const char* what, std::string* out) {
+  const AttrValue* a = e.Get("name");
+  if (a == nullptr) {
+    if (!e.Has("name"))
+      Err(e.line(), "<" + std::string(e.tag()) + "> without name=");
+    return false;
+  }
+  const std::string& v = a->value;
+  std::string w = what;
+  if (v.empty()) {
+    Err(a->line, "empty " + w + " name");
+    return false;
+  }
+  for (char c : v) {
+    bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '.' || c == '-';
+    if (!ok) {
+      std::string ch = (static_cast<unsigned char>(c) & 0x80) ? std::string("non-ASCII character")
+                                                              : "invalid character " +
+                                                                    Quote(std::string_view(&c, 1));
+      Err(a->line, ch + " in " + w + " name " + Quote(v) + " (allowed: A-Z a-z 0-9 _ . -)");
+      return false;
+    }
+  }
+  if (v.size() > kMaxNameLength) {
+    Err(a->line, w + " name " + Quote(v) + " is " + std::to_string(v.size()) +
+                     " characters long (at most " + std::to_string(kMaxNameLength) + ")");
+    return false;
+  }
+  if (v[0] == '.' || v[0] == '-') {
+    Err(a->line, w + " name " + Quote(v) + " must not start with '.' or '-'");
+    return false;
+  }
+  *out = v;
+  return true;
+}
+
+bool Parser::NumberOk(const AttrValue& a, const char* attr, NumResult r, bool in_range,
+                      const std::string& range) {
+  if (r == NumResult::kSyntax) {
+    Err(a.line, "invalid " + std::string(attr) + " " + Quote(a.value) + " (expected an integer " + range + ")");
+    return false;
+  }
+  if (r == NumResult::kRange || !in_range) {
+    Err(a.line, std::string(attr) + " " + a.value + " out of range (expected " + range + ")");
+    return false;
+  }
+  return true;
+}
+
+
+bool Parser::Signed(const Element& e, const char* attr, int64_t lo, int64_t hi, int* out) {
+  const AttrValue* a = e.Get(attr);
+  if (a == nullptr) return false;
+  int64_t v = 0;
+  std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+  NumResult r = ParseI64(a->value, &v, /*allow_hex=*/false);
+  if (!NumberOk(*a, attr, r, v >= lo && v <= hi, range)) return false;
+  *out = static_cast<int>(v);
+  return true;
+}
+
+bool Parser::Bool(const Element& e, const char* attr, bool* out) {
+  const AttrValue* a = e.Get(attr);
+  if (a == nullptr) return false;
+  if (!ParseBool(a->value, out)) {
+    Err(a->line, "invalid " + std::string(attr) + " " + Quote(a->value) +
+                     " (expected true, false, 1 or 0)");
+    return false;
+  }
+  return true;
+}
+
+// XML forbids "--" inside a comment. RapidXML does not care, but xmllint, Python's
+// ElementTree and editors reject such a file, and the same file must work for them too.
+void CheckComments(const Node* parent, Diagnostics* diag) {
+  for (const Node* c = parent->first_node(); c; c = c->next_sibling()) {
+    if (c->type() == rapidxml::node_element) {
+      CheckComments(c, diag);
+      continue;
+    }
+    if (c->type() != rapidxml::node_comment) continue;
+    std::string_view v(c->value(), c->value_size());
+    size_t dd = v.find("--");
+    if (dd == std::string_view::npos && !v.empty() && v.back() == '-') dd = v.size() - 1;
+    if (dd != std::string_view::npos)
+      diag->Error(diag->LineOf(c->value() + dd),
+                  "'--' inside a comment (not allowed in XML; other XML tools reject the file)");
+  }
+}
+
+void Parser::Run(const Node* doc, SystemConfig* cfg) {
+  CheckComments(doc, &diag_);
+  const Node* root = nullptr;
+  for (const Node* c = doc->first_node(); c; c = c->next_sibling()) {
+    if (c->type() != rapidxml::node_element) continue;
+    if (root == nullptr) {
+      root = c;
+    } else {
+      Err(diag_.LineOf(c->name()), "second root element <" + std::string(NameOf(c)) +
+                                       "> (everything belongs inside <ccomm>)");
+    }
+  }
+  if (root == nullptr) {
+    Err(1, "no root element (expected <ccomm version=\"1\">)");
+    return;
+  }
+  if (NameOf(root) != "ccomm") {
+    Err(diag_.LineOf(root->name()), "root element is <" + std::string(NameOf(root)) +
+                                        ">; expected <ccomm version=\"1\">");
+    return;
+  }
+  Root(root, cfg);
+  CrossCheck(cfg);
+}
+
+void Parser::Root(const Node* root, SystemConfig* cfg) {
+  // xmlns:xsi / xsi:noNamespaceSchemaLocation let editors validate against signals.xsd.
+  Element e(root, {"version", "xmlns:xsi", "xsi:noNamespaceSchemaLocation"}, &diag_);
+  if (const AttrValue* v = e.Get("version")) {
+    if (v->value != "1")
+      Err(v->line, "unsupported format version " + Quote(v->value) +
+                       " (this ccomm reads version 1)");
+  } else if (!e.Has("version")) {
+    Err(e.line(), "<ccomm> without version= (expected version=\"1\")");
+  }
+  CheckNoText(root, &diag_);
+
+  int network_line = 0;
+  int nodes_seen = 0, signals_seen = 0;
+  int node_elements = 0;
+  for (const Node* c = root->first_node("node"); c; c = c->next_sibling("node")) ++node_elements;
+  const std::vector<std::string> kChildren = {"network", "node", "signal"};
+  for (const Node* c = root->first_node(); c; c = c->next_sibling()) {
+    if (c->type() != rapidxml::node_element) continue;
+    std::string_view name = NameOf(c);
+    int line = diag_.LineOf(c->name());
+    if (name == "network") {
+      if (network_line) {
+        Err(line, "second <network> (first at line " + std::to_string(network_line) + ")");
+        continue;
+      }
+      network_line = line;
+      Network(c, &cfg->network);
+    } else if (name == "node") {
+      if (++nodes_seen == static_cast<int>(kMaxNodes) + 1)
+        Err(line, "too many nodes (at most " + std::to_string(kMaxNodes) + ")");
+      NodeConfig node;
+      NodeElement(c, node_elements == 1, &node);
+      if (nodes_seen <= static_cast<int>(kMaxNodes)) cfg->nodes.push_back(std::move(node));
+    } else if (name == "signal") {
+      if (++signals_seen == static_cast<int>(kMaxSignals) + 1)
+        Err(line, "too many signals (at most " + std::to_string(kMaxSignals) + ")");
+      SignalConfig sig;
+      SignalRefs refs;
+      SignalElement(c, &sig, &refs);
+      if (signals_seen <= static_cast<int>(kMaxSignals)) {
+        cfg->signals.push_back(std::move(sig));
+        refs_.push_back(std::move(refs));
+      }
+    } else {
+      std::string hint = Suggest(name, kChildren);
+      if (hint.empty()) hint = " (expected network, node or signal)";
+      Err(line, "unknown element <" + std::string(name) + "> in <ccomm>" + hint);
+    }
+  }
+  if (nodes_seen == 0) Err(diag_.LineOf(root->name()), "no <node> defined");
+}
+
+void Parser::Network(const Node* n, NetworkConfig* net) {
+  Element e(n, {"ethertype", "udp_port", "heartbeat_ms", "peer_timeout_ms", "auth_key_file"},
+            &diag_);
+  CheckNoText(n, &diag_);
+  if (n->first_node(nullptr))
+    for (const Node* c = n->first_node(); c; c = c->next_sibling())
+      if (c->type() == rapidxml::node_element)
+        Err(diag_.LineOf(c->name()), "unknown element <" + std::string(NameOf(c)) +
+                                         "> in <network> (it has no child elements)");
+  // EtherType values below 0x0600 are 802.3 frame lengths, not protocol numbers.
+  Unsigned(e, "ethertype", 0x0600, 0xFFFF, &net->ethertype, /*hex=*/true);
+  Unsigned(e, "udp_port", 1, 65535, &net->udp_port);
+  bool hb_ok = Unsigned(e, "heartbeat_ms", 1, kMaxHeartbeatMs, &net->heartbeat_ms) ||
+               !e.Has("heartbeat_ms");
+  bool pt_ok = Unsigned(e, "peer_timeout_ms", 1, kMaxPeerTimeoutMs, &net->peer_timeout_ms) ||
+               !e.Has("peer_timeout_ms");
+  if (hb_ok && pt_ok && net->peer_timeout_ms < 2 * net->heartbeat_ms) {
+    const AttrValue* a = e.Get("peer_timeout_ms");
+    Err(a ? a->line : e.line(),
+        "peer_timeout_ms " + std::to_string(net->peer_timeout_ms) + " is less than twice " +
+            "heartbeat_ms " + std::to_string(net->heartbeat_ms) +
+            " (one lost heartbeat would declare the peer dead)");
+  }
+  if (const AttrValue* a = e.Get("auth_key_file")) {
+    if (a->value.empty())
+      Err(a->line, "empty auth_key_file (omit it to disable authentication)");
+    else if (a->value[0] != '/')
+      Err(a->line, "auth_key_file " + Quote(a->value) + " is not an absolute path");
+    else
+      net->auth_key_file = a->value;
+  }
+}
+
+void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
+  Element e(n, {"name", "interface", "mac", "ip", "multicast", "transport"}, &diag_);
+  node->line = e.line();
+  Name(e, "node", &node->name);
+  CheckNoText(n, &diag_);
+  int realtime_line = 0;
+  for (const Node* c = n->first_node(); c; c = c->next_sibling()) {
+    if (c->type() != rapidxml::node_element) continue;
+    int line = diag_.LineOf(c->name());
+    if (NameOf(c) != "realtime") {
+      std::string hint = Suggest(NameOf(c), {"realtime"});
+      if (hint.empty()) hint = " (expected realtime)";
+      Err(line, "unknown element <" + std::string(NameOf(c)) + "> in <node>" + hint);
+    } else if (realtime_line) {
+      Err(line, "second <realtime> in node (first at line " + std::to_string(realtime_line) + ")");
+    } else {
+      realtime_line = line;
+      Realtime(c, &node->realtime);
+    }
+  }
+
+  bool transport_ok = true;
+  if (const AttrValue* a = e.Get("transport")) {
+    if (a->value == "raw") {
+      node->transport = TransportKind::kRaw;
+    } else if (a->value == "udp") {
+      node->transport = TransportKind::kUdp;
+    } else {
+      Err(a->line, "unknown transport " + Quote(a->value) + " (expected raw or udp)");
+      transport_ok = false;
+    }
+  }
+  if (const AttrValue* a = e.Get("interface")) {
+    const std::string& v = a->value;
+    bool ok = !v.empty() && v.size() <= kMaxInterfaceName && v != "." && v != "..";
+    for (char c : v)
+      if (c == '/' || c == ':' || static_cast<unsigned char>(c) <= ' ' || c == 0x7f) ok = false;
+    if (!ok)
+      Err(a->line, "invalid interface name " + Quote(v) +
+                       " (1 to 15 characters, no '/', ':' or whitespace)");
+    else
+      node->interface = v;
+  }
+  if (const AttrValue* a = e.Get("mac")) {
+    if (!ParseMac(a->value, node->mac)) {
+      Err(a->line, "invalid mac " + Quote(a->value) + " (expected six hex pairs, e.g. 02:00:00:00:00:01)");
+    } else if (node->mac[0] & 1) {
+      Err(a->line, "mac " + a->value +
+                       " is a multicast/broadcast address (omit mac= to send to broadcast)");
+    } else if (std::all_of(node->mac, node->mac + 6, [](uint8_t b) { return b == 0; })) {
+      Err(a->line, "mac 00:00:00:00:00:00 is not a valid station address");
+    } else {
+      node->has_mac = true;
+    }
+  }
+  if (const AttrValue* a = e.Get("ip")) {
+    uint8_t q[4];
+    if (!ParseIpv4(a->value, q)) {
+      Err(a->line, "invalid ip " + Quote(a->value) + " (expected an IPv4 address like 10.42.0.1)");
+    } else if (q[0] >= 224 || (q[0] == 0 && q[1] == 0 && q[2] == 0 && q[3] == 0)) {
+      Err(a->line, "ip " + a->value + " is not a unicast address");
+    } else {
+      node->ip = a->value;
+    }
+  }
+  if (const AttrValue* a = e.Get("multicast")) {
+    uint8_t q[4];
+    if (!ParseIpv4(a->value, q)) {
+      Err(a->line, "invalid multicast " + Quote(a->value) +
+                       " (expected an IPv4 address like 239.42.0.1)");
+    } else if (q[0] < 224 || q[0] > 239) {
+      Err(a->line, "multicast " + a->value + " is not in 224.0.0.0/4");
+    } else {
+      node->multicast = a->value;
+    }
+  }
+  // A node that is alone in the file talks to nobody (shared memory only), so it needs
+  // no network settings; Root() passes that in.
+  if (transport_ok && !node->name.empty() && !only_node) {
+    if (node->transport == TransportKind::kRaw && !e.Has("interface"))
+      Err(e.line(), "raw node " + Quote(node->name) +
+                        " needs interface= (the network interface its frames use)");
+    if (node->transport == TransportKind::kUdp && !e.Has("ip"))
+      Err(e.line(), "udp node " + Quote(node->name) +
+                        " needs ip= (the IPv4 address its peers send to)");
+  }
+}
+
+void Parser::Realtime(const Node* n, RealtimeConfig* rt) {
+  Element e(n, {"mlockall", "priority", "cpu", "spin_us"}, &diag_);
+  CheckNoText(n, &diag_);
+  for (const Node* c = n->first_node(); c; c = c->next_sibling())
+    if (c->type() == rapidxml::node_element)
+      Err(diag_.LineOf(c->name()), "unknown element <" + std::string(NameOf(c)) +
+                                       "> in <realtime> (it has no child elements)");
+  Bool(e, "mlockall", &rt->mlockall);
+  Signed(e, "priority", 1, 99, &rt->priority);
+  Signed(e, "cpu", 0, kMaxCpu, &rt->cpu);
+  Unsigned(e, "spin_us", 0, kMaxSpinUs, &rt->spin_us);
+}
+
+}  // namespace config_detail
+}  // namespace ccomm

@@ -18,7 +18,7 @@ MAX_LOSS_FLOOR=${QT_LAT_MAX_LOSS_FLOOR:-2}  # % of replies the floor may lose at
 OUT=$QT_WORK/latency.jsonl
 : >"$OUT"
 
-# The two programs shared with the benchmarks (src/bench, src/tools), as installed.
+# The two programs shared with the benchmarks (bench/, src/tools), as installed.
 NF=$(vm planner 'command -v net_floor || ls /usr/libexec/ccomm/bench/net_floor 2>/dev/null' | head -n1)
 SF=$(vm control 'command -v shm_floor || ls /usr/libexec/ccomm/bench/shm_floor 2>/dev/null' | head -n1)
 # An image from elsewhere (--kernel/--rootfs, e.g. Yocto's ccomm-image, whose recipe builds

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Result rows: the schema every measurement (floor, peer, ccomm) reports in.
 
-A row is a dict with at least SCHEMA_FIELDS. Programs in src/bench print one such
+A row is a dict with at least SCHEMA_FIELDS. Programs in bench/ print one such
 JSON object per line; ccomm rows can be made from raw samples with row_from_samples().
 Optional keys used here: "metric" ("rtt", "rtt_half", "one_way"), "group" (which plot
 a row belongs to), "raw" (raw-sample file relative to the output directory), "note".

@@ -702,7 +702,7 @@ clock, so on two boards measure round trips (RTT/2) or synchronise the clocks (P
 `ptp4l`/`phc2sys`, sub-microsecond on the same switch) first.
 
 1. Build and install ccomm on both boards (the Yocto image has `ccommd`, `ccomm`,
-   `ccomm-latency`; the floor programs are in `libexec/ccomm/bench`, built from `src/bench`).
+   `ccomm-latency`; the floor programs are in `libexec/ccomm/bench`, built from `bench/`).
 2. Give both boards the same configuration (e.g. `examples/single-signal.xml` or the
    default `dist/signals.xml` for the setup-simulation) with the boards' real interface,
    MAC and IP addresses, and start `ccommd` on each (systemd unit, or
@@ -728,7 +728,7 @@ clock, so on two boards measure round trips (RTT/2) or synchronise the clocks (P
    `heartbeats_rx` against the `sent` cycles `ccomm-latency` prints.
 
 On one board (on-target), with `ccommd` running for a node whose file has two state doubles
-`ping8`, `pong8` produced there (see `scripts/benchlib/ccomm.py`, `local_config`):
+`ping8`, `pong8` produced there (see `bench/benchlib/ccomm.py`, `local_config`):
 
    ```
    ccomm_pingpong --role echo --node NODE --ping ping8 --pong pong8 --payload 8 --cpu 1 --floor-shm /ccpp-1 --cycle-time &
@@ -738,7 +738,7 @@ On one board (on-target), with `ccommd` running for a node whose file has two st
    cache-line floor (`floor_p50_ns`) and the median block ratio (`paired_ratio`).
 
 `scripts/bench` itself drives namespaces on one host; its building blocks
-(`scripts/benchlib/ccomm.py`: configuration generator, `Daemons`, `latency_argv`) take the
+(`bench/benchlib/ccomm.py`: configuration generator, `Daemons`, `latency_argv`) take the
 node names, addresses and CPUs as parameters.
 """
 

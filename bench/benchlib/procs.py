@@ -115,7 +115,7 @@ def wait_for_text(path, text, timeout, proc=None):
 
 
 class NetnsPair:
-    """Two namespaces joined by veth (scripts/benchlib/netns.sh): ns_a/ns_b, eth0 in each."""
+    """Two namespaces joined by veth (bench/benchlib/netns.sh): ns_a/ns_b, eth0 in each."""
 
     IP_A, IP_B = "198.18.76.1", "198.18.76.2"
     MAC_A, MAC_B = "02:cc:b0:00:00:01", "02:cc:b0:00:00:02"

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm-ros2: the bridge between a node's ccomm signals and ROS 2 (Cyclone DDS).
+// One route per bridged signal; the ccomm -> ROS 2 routes belong to one thread and the
+// ROS 2 -> ccomm routes to another, each with its own ccomm handle.
+#pragma once
+
+#include <ccomm/ccomm.h>
+#include <dds/dds.h>
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ccomm_ros2 {
+
+enum class StampMode { kWrite, kArrival };
+
+struct Options {
+  std::string node;                  // empty: $CCOMM_NODE, else the hostname
+  std::string ros_namespace = "ccomm";
+  int domain = 0;
+  std::vector<std::string> publish;  // ccomm -> ROS 2; empty: every signal consumed here
+  bool publish_given = false;
+  std::vector<std::string> subscribe;  // ROS 2 -> ccomm: signals produced here
+  StampMode stamp = StampMode::kWrite;
+  double stats_interval_s = 0;       // 0: stats only on SIGUSR1 and at exit
+  bool list_only = false;
+  int verbose = 0;
+};
+
+// Parses argv into `o`; returns -1 to go on, else the exit status (help printed: 0,
+// usage error: 2, with a message on stderr).
+int ParseOptions(int argc, char** argv, Options* o);
+
+// A signal name usable as one ROS 2 topic name token.
+bool ValidRosTopicToken(const std::string& s);
+
+// The ROS 2 message type of a ccomm signal (see dds_types.cpp).
+struct RosType {
+  const char* ros_name;                // "std_msgs/msg/Float64"
+  const dds_topic_descriptor_t* desc;  // DDS type std_msgs::msg::dds_::Float64_
+  const char* type_hash;               // "RIHS01_<64 hex>"
+  bool is_array;                       // *MultiArray
+};
+// nullptr if no std_msgs type carries this ccomm type.
+const RosType* RosTypeFor(int32_t ccomm_type, uint32_t count);
+
+// Counters of one route, written by its thread, read by the stats printer (relaxed).
+struct RouteCounters {
+  std::atomic<uint64_t> published{0};       // samples written to DDS
+  std::atomic<uint64_t> skipped{0};         // state values overwritten before the bridge read them
+  std::atomic<uint64_t> stale{0};           // fresh -> stale transitions (ROS sees a deadline miss)
+  std::atomic<uint64_t> lost{0};            // events ccomm reported lost before the bridge
+  std::atomic<uint64_t> dds_errors{0};      // dds_write/take failures
+  std::atomic<uint64_t> received{0};        // DDS samples taken
+  std::atomic<uint64_t> written{0};         // of those, written into ccomm
+  std::atomic<uint64_t> refused_length{0};  // array length (or layout) is not the signal's count
+  std::atomic<uint64_t> refused_value{0};   // a value the signal's type cannot hold (bool 0/1)
+  std::atomic<uint64_t> ccomm_errors{0};    // ccomm_write failed (e.g. event queue full)
+  std::atomic<uint64_t> wrong_type_peers{0};  // DDS writers on this topic with another type
+};
+
+struct Route {
+  std::string name;   // ccomm signal name
+  std::string topic;  // "rt/<namespace>/<name>"
+  ccomm_signal id = -1;
+  ccomm_signal_desc desc{};  // name/producer pointers are not kept valid across reopens
+  const RosType* type = nullptr;
+  bool to_ros = true;
+  dds_entity_t topic_entity = 0, endpoint = 0;  // writer (to_ros) or reader
+  void* sample = nullptr;   // preallocated DDS sample (dds_alloc, freed at exit)
+  uint64_t last_seq = 0;    // to_ros: seq of the last value published
+  uint64_t last_lost = 0;   // to_ros: the handle's lost count already counted
+  bool fresh = false;       // to_ros: the last read was fresh
+  RouteCounters n;
+};
+
+struct Bridge {
+  Options opt;
+  std::string node;  // the ccomm node actually opened
+  dds_entity_t participant = 0;
+  std::vector<Route*> to_ros, from_ros;
+  std::atomic<uint64_t> reopens{0};
+  std::atomic<bool> stop{false};
+  std::atomic<int> fatal{0};  // non-zero: exit status a worker asks for
+};
+
+// Opens the node's segment, waiting (with one message) while ccommd has not created it.
+// Returns nullptr only when asked to stop.
+ccomm_client* OpenWaiting(Bridge* b);
+// Finds the routes' signals again after a (re)open and checks that their type did not
+// change; false (with a message) if a route cannot be served by this handle.
+bool ResolveRoutes(Bridge* b, ccomm_client* c, const std::vector<Route*>& routes);
+
+// DDS entities of every route; false with a message on stderr.
+bool CreateDdsEntities(Bridge* b);
+void DestroyDdsEntities(Bridge* b);
+
+// Worker threads (return when b->stop is set or a fatal error happened).
+void RunToRos(Bridge* b);
+void RunFromRos(Bridge* b);
+
+// One JSON line with every counter, to stdout.
+void PrintStats(const Bridge* b);
+
+}  // namespace ccomm_ros2

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm-ros2 command line.
+#include <getopt.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "bridge.h"
+
+namespace ccomm_ros2 {
+namespace {
+
+const char kUsage[] =
+    "Usage: ccomm-ros2 [OPTIONS]     (also: ccomm [--node NODE] ros2 [OPTIONS])\n"
+    "\n"
+    "Bridges this node's ccomm signals to ROS 2 over Eclipse Cyclone DDS: every signal\n"
+    "this node consumes appears as the ROS 2 topic /NAMESPACE/SIGNAL (DDS topic\n"
+    "rt/NAMESPACE/SIGNAL, std_msgs types), and signals this node produces can be fed from\n"
+    "ROS 2 topics. A stale signal is not re-published: ROS 2 subscribers see the DDS\n"
+    "deadline (= stale_after_ms) missed. See docs/integrations/ros2.md.\n"
+    "\n"
+    "Options:\n"
+    "  -n, --node NODE           ccomm node to attach to (default: $CCOMM_NODE, else the\n"
+    "                            hostname); ccommd must run as that node\n"
+    "  -s, --namespace NS        ROS 2 namespace of the topics (default: ccomm; '' or /\n"
+    "                            for none)\n"
+    "  -d, --domain ID           ROS 2 domain id, 0..232 (default: $ROS_DOMAIN_ID, else 0)\n"
+    "  -p, --publish SIG[,SIG]   signals to publish to ROS 2 (default: every signal this\n"
+    "                            node consumes; 'none' for none); repeatable\n"
+    "  -S, --subscribe SIG[,SIG] signals produced by this node to take from ROS 2 topics;\n"
+    "                            repeatable\n"
+    "      --stamp write|arrival DDS source timestamp of a sample: the ccomm write time on\n"
+    "                            the producer (default; exact when the producer's\n"
+    "                            CLOCK_MONOTONIC is this node's), or the time the value\n"
+    "                            reached this node (for boards whose clocks differ)\n"
+    "      --stats SECONDS       print the counters as one JSON line every SECONDS\n"
+    "                            (always on SIGUSR1 and at exit)\n"
+    "  -l, --list                print the topics, types and QoS the bridge would use, and exit\n"
+    "  -v, --verbose             more messages on stderr\n"
+    "  -h, --help                this text\n"
+    "\n"
+    "DDS settings (interfaces, discovery peers) come from CYCLONEDDS_URI as for any Cyclone\n"
+    "DDS program. Exit status: 0 on SIGINT/SIGTERM, 1 on an error at run time (e.g. a\n"
+    "signal's type changed under a new configuration), 2 on a usage error.\n";
+
+void SplitInto(const char* arg, std::vector<std::string>* out) {
+  const char* p = arg;
+  while (*p) {
+    const char* comma = strchr(p, ',');
+    size_t n = comma ? static_cast<size_t>(comma - p) : strlen(p);
+    if (n) out->emplace_back(p, n);
+    p += n + (comma ? 1 : 0);
+  }
+}
+
+bool ParseDomain(const char* s, const char* what, int* out) {
+  char* end = nullptr;
+  errno = 0;
+  long v = strtol(s, &end, 10);
+  if (errno || !*s || *end || v < 0 || v > 232) {
+    fprintf(stderr,
+            "ccomm-ros2: bad domain '%s' (%s): a ROS 2 domain id is an integer 0..232 "
+            "(DDS derives UDP ports from it)\n", s, what);
+    return false;
+  }
+  *out = static_cast<int>(v);
+  return true;
+}
+
+// ROS 2 topic name tokens: letters, digits and '_', not starting with a digit; '/'
+// separates tokens (no empty ones).
+bool ValidRosName(const std::string& s, bool allow_slash) {
+  bool token_start = true;
+  for (char ch : s) {
+    if (ch == '/' && allow_slash) {
+      if (token_start) return false;
+      token_start = true;
+      continue;
+    }
+    bool alpha = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || ch == '_';
+    bool digit = ch >= '0' && ch <= '9';
+    if (!alpha && !(digit && !token_start)) return false;
+    token_start = false;
+  }
+  return !token_start || s.empty();
+}
+
+}  // namespace
+
+int ParseOptions(int argc, char** argv, Options* o) {
+  enum { kStamp = 1000, kStats };
+  static const struct option kLong[] = {
+      {"node", required_argument, nullptr, 'n'},   {"namespace", required_argument, nullptr, 's'},
+      {"domain", required_argument, nullptr, 'd'}, {"publish", required_argument, nullptr, 'p'},
+      {"subscribe", required_argument, nullptr, 'S'}, {"stamp", required_argument, nullptr, kStamp},
+      {"stats", required_argument, nullptr, kStats}, {"list", no_argument, nullptr, 'l'},
+      {"verbose", no_argument, nullptr, 'v'},      {"help", no_argument, nullptr, 'h'},
+      {nullptr, 0, nullptr, 0}};
+  if (const char* env = getenv("ROS_DOMAIN_ID"); env && *env) {
+    if (!ParseDomain(env, "from ROS_DOMAIN_ID", &o->domain)) return 2;
+  }
+  int ch;
+  while ((ch = getopt_long(argc, argv, "n:s:d:p:S:lvh", kLong, nullptr)) != -1) {
+    switch (ch) {
+      case 'n': o->node = optarg; break;
+      case 's': o->ros_namespace = optarg; break;
+      case 'd': if (!ParseDomain(optarg, "--domain", &o->domain)) return 2; break;
+      case 'p':
+        o->publish_given = true;
+        if (strcmp(optarg, "none") != 0) SplitInto(optarg, &o->publish);
+        break;
+      case 'S': SplitInto(optarg, &o->subscribe); break;
+      case kStamp:
+        if (strcmp(optarg, "write") == 0) o->stamp = StampMode::kWrite;
+        else if (strcmp(optarg, "arrival") == 0) o->stamp = StampMode::kArrival;
+        else { fprintf(stderr, "ccomm-ros2: --stamp must be 'write' or 'arrival', not '%s'\n", optarg); return 2; }
+        break;
+      case kStats: {
+        char* end = nullptr;
+        o->stats_interval_s = strtod(optarg, &end);
+        if (*end || !(o->stats_interval_s > 0)) {
+          fprintf(stderr, "ccomm-ros2: --stats needs a positive number of seconds, not '%s'\n", optarg);
+          return 2;
+        }
+        break;
+      }
+      case 'l': o->list_only = true; break;
+      case 'v': ++o->verbose; break;
+      case 'h': fputs(kUsage, stdout); return 0;
+      default: fputs("Try 'ccomm-ros2 --help'.\n", stderr); return 2;
+    }
+  }
+  if (optind < argc) {
+    fprintf(stderr, "ccomm-ros2: unexpected argument '%s' (see --help)\n", argv[optind]);
+    return 2;
+  }
+  std::string& ns = o->ros_namespace;  // stored without leading/trailing '/'
+  while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
+  while (!ns.empty() && ns.back() == '/') ns.pop_back();
+  if (!ValidRosName(ns, true)) {
+    fprintf(stderr, "ccomm-ros2: --namespace '%s' is not a ROS 2 name (letters, digits, '_', "
+                    "'/' between tokens, no token starting with a digit)\n", ns.c_str());
+    return 2;
+  }
+  for (const std::string& s : o->publish)
+    for (const std::string& t : o->subscribe)
+      if (s == t) {
+        fprintf(stderr, "ccomm-ros2: %s is both --publish and --subscribe (it would loop)\n", s.c_str());
+        return 2;
+      }
+  return -1;
+}
+
+bool ValidRosTopicToken(const std::string& s) { return !s.empty() && ValidRosName(s, false); }
+
+}  // namespace ccomm_ros2

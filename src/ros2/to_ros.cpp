@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm -> ROS 2: wakes on every change of the node's signals (ccomm_wait), reads each
+// published signal straight into its preallocated DDS sample and writes it with the
+// ccomm write time as source timestamp. Nothing is allocated per sample here.
+#include <ctime>
+
+#include <cstdio>
+
+#include "bridge.h"
+#include "sample_layout.h"
+
+namespace ccomm_ros2 {
+namespace {
+
+int64_t WallNow() {
+  timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);  // vDSO: no syscall
+  return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+// Source timestamp of a value (DDS, like ROS 2, stamps with the wall clock; ccomm with
+// CLOCK_MONOTONIC): the write time, or the arrival time, moved to the wall clock.
+dds_time_t SourceTime(const Bridge* b, const ccomm_info& info) {
+  const int64_t wall = WallNow(), mono = ccomm_now();
+  if (b->opt.stamp == StampMode::kArrival || info.source_time_ns == 0)
+    return wall - (info.age_ns > 0 ? info.age_ns : 0);
+  return wall - (mono - static_cast<int64_t>(info.source_time_ns));
+}
+
+// Where ccomm_read puts the value: the sample itself (scalars) or its data buffer.
+void* ValueOf(Route* r) {
+  return r->type->is_array ? static_cast<ArraySample*>(r->sample)->data_.buffer : r->sample;
+}
+
+bool Publish(Bridge* b, Route* r, const ccomm_info& info) {
+  const dds_time_t ts = SourceTime(b, info);
+  // A reliable KEEP_ALL (event) writer blocks up to 100 ms while a reader's history is
+  // full; retry so no event is dropped for a slow reader that is still there.
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    dds_return_t rc = dds_write_ts(r->endpoint, r->sample, ts);
+    if (rc == DDS_RETCODE_OK) {
+      r->n.published.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
+    if (rc != DDS_RETCODE_TIMEOUT || b->stop.load(std::memory_order_relaxed)) break;
+  }
+  r->n.dds_errors.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+// Reads one signal and publishes what is new and fresh. Returns a ccomm error (< 0)
+// that needs a reopen, else 0.
+int Pump(Bridge* b, ccomm_client* c, Route* r) {
+  void* value = ValueOf(r);
+  ccomm_info info;
+  if (r->desc.is_event) {  // every queued event, in order, once
+    for (int i = 0; i < 100000; ++i) {  // bounded: a writer faster than us cannot pin us here
+      int st = ccomm_read(c, r->id, value, r->desc.value_bytes, &info);
+      if (st < 0) return st;
+      if (st == CCOMM_EMPTY || st == CCOMM_NEVER) break;
+      if (info.lost > r->last_lost) {
+        r->n.lost.fetch_add(info.lost - r->last_lost, std::memory_order_relaxed);
+        r->last_lost = info.lost;
+      }
+      Publish(b, r, info);
+    }
+    return 0;
+  }
+  int st = ccomm_read(c, r->id, value, r->desc.value_bytes, &info);
+  if (st < 0) return st;
+  if (st == CCOMM_FRESH && info.seq != r->last_seq) {
+    if (r->last_seq != 0 && info.seq > r->last_seq + 1)
+      r->n.skipped.fetch_add(info.seq - r->last_seq - 1, std::memory_order_relaxed);
+    r->last_seq = info.seq;
+    r->fresh = true;
+    Publish(b, r, info);
+  } else if (st != CCOMM_FRESH && r->fresh) {
+    // Not re-published: the DDS writer's deadline (stale_after_ms) tells ROS 2 readers.
+    r->fresh = false;
+    r->n.stale.fetch_add(1, std::memory_order_relaxed);
+    if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: %s is stale\n", r->name.c_str());
+  } else if (st == CCOMM_FRESH) {
+    r->fresh = true;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void RunToRos(Bridge* b) {
+  if (b->to_ros.empty()) return;
+  ccomm_client* c = OpenWaiting(b);
+  if (!c) return;
+  if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }
+  for (Route* r : b->to_ros) {  // a state value already there counts as seen, not new
+    ccomm_info info;
+    if (!r->desc.is_event && ccomm_read(c, r->id, ValueOf(r), r->desc.value_bytes, &info) >= 0)
+      r->last_seq = info.seq;
+  }
+  while (!b->stop.load(std::memory_order_relaxed)) {
+    ccomm_wait(c, 100);  // returns at once on a change; 100 ms to notice stop/retirement
+    int err = 0;
+    for (Route* r : b->to_ros) {
+      err = Pump(b, c, r);
+      if (err < 0) break;
+    }
+    if (err == CCOMM_E_RETIRED || err == CCOMM_E_VERSION) {
+      // ccommd replaced the segment (restart with a new configuration): attach anew.
+      if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: segment retired, reopening\n");
+      ccomm_close(c);
+      c = OpenWaiting(b);
+      if (!c) return;
+      if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; break; }
+      b->reopens.fetch_add(1, std::memory_order_relaxed);
+      for (Route* r : b->to_ros) r->last_seq = r->last_lost = 0;  // a new segment counts anew
+    } else if (err < 0) {
+      fprintf(stderr, "ccomm-ros2: reading signals: %s\n", ccomm_strerror(err));
+      b->fatal = 1;
+      b->stop = true;
+    }
+  }
+  if (c) ccomm_close(c);
+}
+
+}  // namespace ccomm_ros2

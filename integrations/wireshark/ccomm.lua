@@ -87,9 +87,13 @@ for _, name in ipairs({ "too_short", "bad_magic", "bad_version", "bad_header", "
   E[name] = ProtoExpert.new("ccomm." .. name, name, expert.group.MALFORMED, expert.severity.ERROR)
 end
 E.bad_signal = ProtoExpert.new("ccomm.bad_signal", "bad_signal", expert.group.PROTOCOL, expert.severity.WARN)
+E.config_mismatch = ProtoExpert.new("ccomm.config_mismatch", "config_mismatch", expert.group.PROTOCOL,
+                                    expert.severity.WARN)
+E.config_error = ProtoExpert.new("ccomm.config_error", "signals.xml not loaded", expert.group.PROTOCOL,
+                                 expert.severity.WARN)
 E.note = ProtoExpert.new("ccomm.note", "note", expert.group.COMMENTS_GROUP, expert.severity.NOTE)
 ccomm.experts = { E.too_short, E.bad_magic, E.bad_version, E.bad_header, E.bad_entry,
-                  E.trailing_bytes, E.bad_signal, E.note }
+                  E.trailing_bytes, E.bad_signal, E.config_mismatch, E.config_error, E.note }
 
 ccomm.prefs.udp_port = Pref.uint("UDP port", 47800, "UDP port of ccomm frames (<network udp_port=...>)")
 ccomm.prefs.ethertype = Pref.uint("EtherType", 0x88B5, "EtherType of raw ccomm frames (<network ethertype=...>)")
@@ -334,7 +338,7 @@ local function dissect(tvb, pinfo, tree)
     if off + size <= clen then return root:add(field, tvb(off, size)) end
   end
   local function finish(summary)
-    if config.error then root:add_proto_expert_info(E.note, config.error) end
+    if config.error then root:add_proto_expert_info(E.config_error, config.error) end
     if flen < rlen then
       root:add_proto_expert_info(E.note, string.format("%d zero byte(s) after the frame: Ethernet padding, dropped as a raw receiver does", rlen - flen))
     end
@@ -430,7 +434,7 @@ local function dissect(tvb, pinfo, tree)
   -- configuration (receiver rule 4), only when a signals.xml is loaded
   ctx.hash_ok = config.hash ~= nil and tvb(8, 4):uint() == config.hash
   if config.hash and not ctx.hash_ok then
-    hash_item:add_proto_expert_info(E.bad_signal, string.format(
+    hash_item:add_proto_expert_info(E.config_mismatch, string.format(
       "config_mismatch: signals.xml (%s) hashes to %08x", config.path, config.hash))
   end
 

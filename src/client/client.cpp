@@ -10,6 +10,7 @@
 
 #include <new>
 
+#include "client/doorbell.h"
 #include "common/platform.h"
 #include "common/value_type.h"
 #include "store/segment.h"
@@ -50,6 +51,7 @@ struct HandleSignal {
 
 struct ccomm_client {
   Segment segment;
+  ccomm::client::Doorbell* doorbell = nullptr;  // tx/rx wake-ups (client/doorbell.h)
   uint32_t flags = 0;
   uint32_t signal_count = 0;
   HandleSignal* sig = nullptr;     // signal_count entries
@@ -157,7 +159,9 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   auto* c = new (std::nothrow) ccomm_client();
   if (!c) return CCOMM_E_SYS;
   int r = c->segment.Open(ccomm::store::SegmentName(node));
+  if (r == 0) r = ccomm::client::DoorbellOpen(c->segment, &c->doorbell);
   if (r != 0) {
+    ccomm::client::DoorbellClose(c->doorbell);
     delete c;
     return MapError(r);
   }
@@ -201,6 +205,7 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
 
 void ccomm_close(ccomm_client* c) {
   if (!c) return;
+  ccomm::client::DoorbellClose(c->doorbell);
   delete[] c->sig;
   delete[] c->cache_bytes;
   delete c;
@@ -330,12 +335,12 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
       c->segment.MarkDirty(id);
       c->pending_tx = true;
     } else {
-      c->segment.NotifyTx(id, ring);
+      ccomm::client::DoorbellNotifyTx(c->doorbell, id, ring);
     }
   }
   // Waiters are woken now (no write to shared lines unless someone waits), at the
   // flush (batch), or see the change when they next wait or time out (no doorbell).
-  if (ring) c->segment.NotifyRx();
+  if (ring) ccomm::client::DoorbellNotifyRx(c->doorbell);
   else if (c->flags & CCOMM_OPEN_BATCH) c->pending_rx = true;
   return 0;
 }
@@ -385,9 +390,9 @@ int ccomm_flush(ccomm_client* c) {
   const bool quiet = (c->flags & CCOMM_OPEN_NO_DOORBELL) != 0;  // no syscall, even here
   if (c->pending_tx) {
     if (quiet) c->segment.header()->tx_doorbell.fetch_add(1, std::memory_order_release);
-    else c->segment.RingTxDoorbell();
+    else ccomm::client::DoorbellRingTx(c->doorbell);
   }
-  if (c->pending_rx && !quiet) c->segment.NotifyRx();
+  if (c->pending_rx && !quiet) ccomm::client::DoorbellNotifyRx(c->doorbell);
   c->pending_tx = c->pending_rx = false;
   return 0;
 }
@@ -404,7 +409,7 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
   if (!c) return CCOMM_E_INVAL;
   st::SegmentHeader* h = c->segment.header();
   // Register first, then look (see SegmentHeader::rx_waiters): a write this look
-  // misses has seen us waiting and bumps the doorbell, so FutexWait returns at once.
+  // misses has seen us waiting and bumps the doorbell, so DoorbellWait returns at once.
   h->rx_waiters.fetch_add(1, std::memory_order_seq_cst);
   uint32_t seen = h->rx_doorbell.load(std::memory_order_seq_cst);
   bool changed = TakeChanges(c);
@@ -418,7 +423,7 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
       if (now >= deadline) break;
       left = static_cast<int64_t>(deadline - now);
     }
-    ccomm::platform::FutexWait(&h->rx_doorbell, seen, left);
+    ccomm::client::DoorbellWait(c->doorbell, seen, left);
     seen = h->rx_doorbell.load(std::memory_order_seq_cst);
     changed = TakeChanges(c);
   }

@@ -15,6 +15,8 @@
 struct ccomm_blk {
   ccomm_client* client;
   ccomm_signal id;
+  int dtype;          /* the port's CCOMM_BLK_* type */
+  int64_t timeout_ns; /* 0: no block timeout */
   int32_t type;
   uint32_t count;
   uint32_t bytes;
@@ -24,14 +26,71 @@ struct ccomm_blk {
   unsigned char* scratch; /* event reads / last event sent */
 };
 
+int ccomm_blk_dtype(const char* name) {
+  static const struct { const char* name; int id; } types[] = {
+      {"double", CCOMM_BLK_DOUBLE}, {"single", CCOMM_BLK_SINGLE}, {"int32", CCOMM_BLK_INT32},
+      {"uint32", CCOMM_BLK_UINT32}, {"boolean", CCOMM_BLK_BOOLEAN}};
+  size_t i;
+  for (i = 0; name && i < sizeof types / sizeof types[0]; i++)
+    if (strcmp(name, types[i].name) == 0) return types[i].id;
+  return -1;
+}
+
+static const char* dtype_name(int dtype) {
+  switch (dtype) {
+    case CCOMM_BLK_DOUBLE: return "double";
+    case CCOMM_BLK_SINGLE: return "single";
+    case CCOMM_BLK_INT32: return "int32";
+    case CCOMM_BLK_UINT32: return "uint32";
+    case CCOMM_BLK_BOOLEAN: return "boolean";
+    default: return "?";
+  }
+}
+
+/* The signal type a non-double port needs; -1 for an unknown port type. */
+static int32_t signal_type_for(int dtype) {
+  switch (dtype) {
+    case CCOMM_BLK_SINGLE: return CCOMM_FLOAT;
+    case CCOMM_BLK_INT32: return CCOMM_INT32;
+    case CCOMM_BLK_UINT32: return CCOMM_UINT32;
+    case CCOMM_BLK_BOOLEAN: return CCOMM_BOOL;
+    default: return -1;
+  }
+}
+
+static const char* signal_type_name(int32_t type) {
+  switch (type) {
+    case CCOMM_BOOL: return "bool";
+    case CCOMM_INT32: return "int32";
+    case CCOMM_UINT32: return "uint32";
+    case CCOMM_INT64: return "int64";
+    case CCOMM_FLOAT: return "float";
+    case CCOMM_DOUBLE: return "double";
+    default: return "?";
+  }
+}
+
 ccomm_blk* ccomm_blk_open(const char* node, const char* signal, int width, int for_write,
                           char* err, size_t err_len) {
+  return ccomm_blk_open_typed(node, signal, width, for_write, CCOMM_BLK_DOUBLE, 0.0, err, err_len);
+}
+
+ccomm_blk* ccomm_blk_open_typed(const char* node, const char* signal, int width, int for_write,
+                                int dtype, double timeout_s, char* err, size_t err_len) {
   ccomm_blk* b;
   ccomm_signal_desc d;
   int r;
   if (err && err_len) err[0] = '\0';
   if (!signal || !signal[0] || width < 1) {
     if (err) snprintf(err, err_len, "ccomm: block needs a signal name and a width >= 1");
+    return NULL;
+  }
+  if (dtype != CCOMM_BLK_DOUBLE && signal_type_for(dtype) < 0) {
+    if (err) snprintf(err, err_len, "ccomm: port data type %d is not one of double, single, int32, uint32, boolean", dtype);
+    return NULL;
+  }
+  if (!(timeout_s >= 0.0) || timeout_s > 1e6) {
+    if (err) snprintf(err, err_len, "ccomm: timeout %g s must be 0 (none) or a positive number of seconds", timeout_s);
     return NULL;
   }
   b = (ccomm_blk*)calloc(1, sizeof *b);
@@ -61,6 +120,14 @@ ccomm_blk* ccomm_blk_open(const char* node, const char* signal, int width, int f
     ccomm_blk_close(b);
     return NULL;
   }
+  if (dtype != CCOMM_BLK_DOUBLE && d.type != signal_type_for(dtype)) {
+    if (err) snprintf(err, err_len, "ccomm: signal '%s' is %s; a port of type %s needs signal type %s (or make the port double)",
+                      signal, signal_type_name(d.type), dtype_name(dtype), signal_type_name(signal_type_for(dtype)));
+    ccomm_blk_close(b);
+    return NULL;
+  }
+  b->dtype = dtype;
+  b->timeout_ns = (int64_t)(timeout_s * 1e9);
   b->type = d.type;
   b->count = d.count;
   b->bytes = d.value_bytes;
@@ -106,11 +173,10 @@ static void set_element(ccomm_blk* b, uint32_t e, double v) {
   }
 }
 
-int ccomm_blk_read(ccomm_blk* b, double* y) {
+/* One sample's read into b->value; returns the block's status. */
+static int fetch(ccomm_blk* b) {
   ccomm_info info;
-  uint32_t e;
   int r, k;
-  if (!b || !y) return CCOMM_E_INVAL;
   if (b->is_event) {
     r = CCOMM_EMPTY;
     for (k = 0; k < EVENT_DRAIN_LIMIT; k++) {
@@ -126,16 +192,33 @@ int ccomm_blk_read(ccomm_blk* b, double* y) {
   } else {
     r = ccomm_read(b->client, b->id, b->value, b->bytes, &info);
     if (r == CCOMM_NEVER && !(info.flags & CCOMM_INFO_SAFE_VALUE)) memset(b->value, 0, b->bytes);
+    if (r == CCOMM_FRESH && b->timeout_ns > 0 && info.age_ns > b->timeout_ns) r = CCOMM_STALE;
   }
+  return r;
+}
+
+int ccomm_blk_read(ccomm_blk* b, double* y) {
+  uint32_t e;
+  int r;
+  if (!b || !y) return CCOMM_E_INVAL;
+  r = fetch(b);
   for (e = 0; e < b->count; e++) y[e] = get_element(b, e);
   return r;
 }
 
-int ccomm_blk_write(ccomm_blk* b, const double* u) {
-  uint32_t e;
+int ccomm_blk_read_port(ccomm_blk* b, void* y) {
   int r;
-  if (!b || !u) return CCOMM_E_INVAL;
-  for (e = 0; e < b->count; e++) set_element(b, e, u[e]);
+  if (!b || !y) return CCOMM_E_INVAL;
+  if (b->dtype == CCOMM_BLK_DOUBLE) return ccomm_blk_read(b, (double*)y);
+  r = fetch(b);
+  /* Same type as the signal (checked at open): the port holds the value's bytes. */
+  memcpy(y, b->value, b->bytes);
+  return r;
+}
+
+/* Sends b->value (events: only when it changed). */
+static int send(ccomm_blk* b) {
+  int r;
   if (b->is_event) {
     if (b->sent_once && memcmp(b->value, b->scratch, b->bytes) == 0) return 0;
     r = ccomm_write(b->client, b->id, b->value, b->bytes);
@@ -146,6 +229,24 @@ int ccomm_blk_write(ccomm_blk* b, const double* u) {
     return r;
   }
   return ccomm_write(b->client, b->id, b->value, b->bytes);
+}
+
+int ccomm_blk_write(ccomm_blk* b, const double* u) {
+  uint32_t e;
+  if (!b || !u) return CCOMM_E_INVAL;
+  for (e = 0; e < b->count; e++) set_element(b, e, u[e]);
+  return send(b);
+}
+
+int ccomm_blk_write_port(ccomm_blk* b, const void* u) {
+  uint32_t e;
+  if (!b || !u) return CCOMM_E_INVAL;
+  if (b->dtype == CCOMM_BLK_DOUBLE) return ccomm_blk_write(b, (const double*)u);
+  memcpy(b->value, u, b->bytes);
+  /* A Simulink boolean is 0 or 1 by contract; any other byte still means true. */
+  if (b->type == CCOMM_BOOL)
+    for (e = 0; e < b->count; e++) b->value[e] = b->value[e] ? 1 : 0;
+  return send(b);
 }
 
 void ccomm_blk_close(ccomm_blk* b) {

@@ -19,11 +19,39 @@ extern "C" {
 
 typedef struct ccomm_blk ccomm_blk;
 
+/* Port data types, numbered as Simulink's built-in DTypeId (SS_DOUBLE, ...), so the
+ * S-functions and the TLC files pass the port's type id through unchanged. A double port
+ * converts to and from any signal type; every other port type must be the signal's own
+ * type (its values are copied, never converted). */
+enum {
+  CCOMM_BLK_DOUBLE = 0,  /* real_T */
+  CCOMM_BLK_SINGLE = 1,  /* real32_T <-> float signals */
+  CCOMM_BLK_INT32 = 6,   /* int32_T <-> int32 signals */
+  CCOMM_BLK_UINT32 = 7,  /* uint32_T <-> uint32 signals */
+  CCOMM_BLK_BOOLEAN = 8  /* boolean_T (one byte, 0/1) <-> bool signals */
+};
+
+/* Returns the CCOMM_BLK_* id of a type name ("double", "single", "int32", "uint32",
+ * "boolean"), or -1. */
+int ccomm_blk_dtype(const char* name);
+
 /* Opens signal `signal` of node `node` (NULL or "": $CCOMM_NODE, else the hostname) for a
  * block with `width` elements; `for_write` = 1 for the write block, which also checks
  * that this node produces the signal. Returns NULL and a message in err on failure. */
 ccomm_blk* ccomm_blk_open(const char* node, const char* signal, int width, int for_write,
                           char* err, size_t err_len);
+
+/* As ccomm_blk_open, for a port of type `dtype` (CCOMM_BLK_*); the signal's type must
+ * be that type unless the port is double. timeout_s > 0 (read blocks): a state value older
+ * than that reads as stale (status 1, the value as read) even before the signal's
+ * stale_after_ms; 0 = only the configuration decides. */
+ccomm_blk* ccomm_blk_open_typed(const char* node, const char* signal, int width, int for_write,
+                                int dtype, double timeout_s, char* err, size_t err_len);
+
+/* Read and write for a block opened with ccomm_blk_open_typed: y / u point to `width`
+ * elements of the port's type. Same statuses and rules as ccomm_blk_read / _write. */
+int ccomm_blk_read_port(ccomm_blk* b, void* y);
+int ccomm_blk_write_port(ccomm_blk* b, const void* u);
 
 /* Read block, once per sample: y[width] gets the value as doubles. Returns the ccomm
  * status (0 fresh, 1 stale, 2 never received, 3 no new event) or a negative ccomm

@@ -4,10 +4,15 @@
  *
  * Parameters: 1 signal name (char), 2 sample time in s (-1 = inherited),
  *             3 width (elements of the signal), 4 node name (char, '' = $CCOMM_NODE
- *             or the hostname).
- * Outputs:    1 the value (width doubles), 2 the status of this sample: 0 fresh,
- *             1 stale (the safe value if one is configured), 2 never received,
- *             3 no new event; negative = a ccomm error (see ccomm.h).
+ *             or the hostname), 5 data type ('double', 'single', 'int32', 'uint32',
+ *             'boolean'), 6 timeout in s (0 = signals.xml decides), 7 status output
+ *             (0/1). The ccomm_lib.mdl block mask sets them by name; models made
+ *             before it give only 1-4 (double port, status output).
+ * Outputs:    1 the value (width elements of the data type; double converts from any
+ *             signal type, other types must be the signal's), 2 (status output on)
+ *             the status of this sample: 0 fresh, 1 stale (the safe value if one is
+ *             configured; or older than the timeout), 2 never received, 3 no new
+ *             event; negative = a ccomm error (see ccomm.h).
  * The signal is opened in mdlStart and closed in mdlTerminate; mdlOutputs makes one
  * non-blocking ccomm read. Code generation: sfun_ccomm_read.tlc calls the same
  * ccomm_blk.c functions.
@@ -26,19 +31,23 @@
 
 static void mdlInitializeSizes(SimStruct* S) {
   int width = sfun_ccomm_init_params(S);
+  int status = param_status(S) == 1;
   if (width == 0) return;
   if (!ssSetNumInputPorts(S, 0)) return;
-  if (!ssSetNumOutputPorts(S, 2)) return;
+  if (!ssSetNumOutputPorts(S, status ? 2 : 1)) return;
   ssSetOutputPortWidth(S, 0, width);
-  ssSetOutputPortWidth(S, 1, 1);
+  ssSetOutputPortDataType(S, 0, (DTypeId)param_dtype(S));
+  if (status) {
+    ssSetOutputPortWidth(S, 1, 1);
+    ssSetOutputPortDataType(S, 1, SS_DOUBLE);
+  }
   sfun_ccomm_init_work(S);
 }
 
 static void mdlOutputs(SimStruct* S, int_T tid) {
-  real_T* y = ssGetOutputPortRealSignal(S, 0);
-  real_T* status = ssGetOutputPortRealSignal(S, 1);
+  int r = ccomm_blk_read_port((ccomm_blk*)ssGetPWork(S)[0], ssGetOutputPortSignal(S, 0));
   UNUSED_ARG(tid);
-  status[0] = (real_T)ccomm_blk_read((ccomm_blk*)ssGetPWork(S)[0], y);
+  if (ssGetNumOutputPorts(S) > 1) ssGetOutputPortRealSignal(S, 1)[0] = (real_T)r;
 }
 
 #ifdef MATLAB_MEX_FILE

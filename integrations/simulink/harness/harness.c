@@ -39,8 +39,8 @@ static const char* node;
 typedef struct {
   SimStruct s;
   const harness_methods* m;
-  mxArray p[4];
-  real_T in[64], out0[64], out1[64];
+  mxArray p[7];
+  real_T in[64], out0[64], out1[64]; /* port buffers; typed ports use them as raw memory */
 } block;
 
 static void sleep_ms(int ms) {
@@ -50,28 +50,54 @@ static void sleep_ms(int ms) {
   nanosleep(&t, NULL);
 }
 
+/* The parameters of a block from the masked library (7) or of an older model (4). */
+typedef struct {
+  const char* name;
+  double ts, width;
+  const char* node;
+  const char* dtype; /* 7-parameter form only */
+  double timeout, status;
+  int n_params;
+} block_params;
+
 /* Sets up a block like Simulink does when a model is updated and started. Returns the
  * error status (NULL = block started). */
-static const char* block_start(block* b, const harness_methods* m, const char* name, double ts,
-                               double width, const char* node_name, int n_params) {
+static const char* block_start_p(block* b, const harness_methods* m, const block_params* bp) {
   memset(b, 0, sizeof *b);
   b->m = m;
   b->s.path = m->name;
-  b->p[0] = (mxArray){1, strlen(name), name, 0.0};
-  b->p[1] = (mxArray){0, 1, NULL, ts};
-  b->p[2] = (mxArray){0, 1, NULL, width};
-  b->p[3] = (mxArray){1, strlen(node_name), node_name, 0.0};
-  for (int i = 0; i < 4; i++) b->s.params[i] = &b->p[i];
-  b->s.n_params_given = n_params;
+  b->p[0] = (mxArray){1, strlen(bp->name), bp->name, 0.0};
+  b->p[1] = (mxArray){0, 1, NULL, bp->ts};
+  b->p[2] = (mxArray){0, 1, NULL, bp->width};
+  b->p[3] = (mxArray){1, strlen(bp->node), bp->node, 0.0};
+  b->p[4] = (mxArray){1, strlen(bp->dtype), bp->dtype, 0.0};
+  b->p[5] = (mxArray){0, 1, NULL, bp->timeout};
+  b->p[6] = (mxArray){0, 1, NULL, bp->status};
+  for (int i = 0; i < 7; i++) b->s.params[i] = &b->p[i];
+  b->s.n_params_given = bp->n_params;
   m->initialize_sizes(&b->s);
   if (b->s.error) return b->s.error;
-  if (b->s.n_params_expected != n_params) return "parameter count mismatch";
+  if (b->s.n_params_expected != -1 && b->s.n_params_expected != bp->n_params) return "parameter count mismatch";
   m->initialize_sample_times(&b->s);
   b->s.in_signal[0] = b->in;
   b->s.out_signal[0] = b->out0;
   b->s.out_signal[1] = b->out1;
   if (m->start) m->start(&b->s);
   return b->s.error;
+}
+
+/* A block of a model made before the library: four parameters, double port. */
+static const char* block_start(block* b, const harness_methods* m, const char* name, double ts,
+                               double width, const char* node_name, int n_params) {
+  block_params bp = {name, ts, width, node_name, "double", 0.0, 1.0, n_params};
+  return block_start_p(b, m, &bp);
+}
+
+/* A masked library block: typed port, timeout, status output on or off. */
+static const char* block_start_typed(block* b, const harness_methods* m, const char* name, double width,
+                                     const char* dtype, double timeout, int status) {
+  block_params bp = {name, 0.01, width, node, dtype, timeout, (double)status, 7};
+  return block_start_p(b, m, &bp);
 }
 
 static void step(block* b) { b->m->outputs(&b->s, 0); }
@@ -194,7 +220,7 @@ static void test_errors(void) {
   e = block_start(&b, &sfun_ccomm_read_mex, "", 0.01, 1, node, 4);
   CHECK(e && strstr(e, "signal name"), "empty name: %s", e ? e : "(started)");
   e = block_start(&b, &sfun_ccomm_read_mex, "sl_scalar", 0.01, 1, node, 3);
-  CHECK(e && strcmp(e, "parameter count mismatch") == 0, "3 parameters: %s", e ? e : "(started)");
+  CHECK(e && strstr(e, "3 parameters; expected 7"), "3 parameters: %s", e ? e : "(started)");
 
   /* A read block on a signal from another node that never arrived: status never. */
   e = block_start(&b, &sfun_ccomm_read_mex, "sl_remote", 0.01, 1, node, 4);
@@ -213,7 +239,8 @@ static void test_rtw(void) {
   if (e) return;
   CHECK(b.m->rtw != NULL, "mdlRTW compiled in the MEX build");
   b.m->rtw(&b.s);
-  CHECK(strcmp(b.s.rtw, "SignalName=\"sl_array\";Node=\"\";Width=3;") == 0, "mdlRTW wrote %s", b.s.rtw);
+  CHECK(strcmp(b.s.rtw, "SignalName=\"sl_array\";Node=\"\";Width=3;DataType=0;Timeout=0;StatusOutput=1;") == 0,
+        "mdlRTW wrote %s", b.s.rtw);
   block_stop(&b);
 }
 
@@ -234,6 +261,8 @@ static void test_codegen_build(void) {
   block_stop(&r);
 }
 
+#include "harness_typed.c"
+
 int main(int argc, char** argv) {
   ccomm_client* c = NULL;
   node = argc > 1 ? argv[1] : "sim";
@@ -253,6 +282,8 @@ int main(int argc, char** argv) {
   test_errors();
   test_rtw();
   test_codegen_build();
+  test_typed_ports();
+  test_typed_options();
   printf("%d passed, %d failed\n", passed, failed);
   return failed ? 1 : 0;
 }

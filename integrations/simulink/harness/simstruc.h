@@ -25,6 +25,20 @@ typedef unsigned int uint_T;
 typedef int int32_T;
 typedef unsigned char boolean_T;
 typedef char char_T;
+typedef float real32_T;
+typedef unsigned int uint32_T;
+
+/* Simulink's built-in data type ids (same numbers as MATLAB's simstruc_types.h). */
+typedef int DTypeId;
+#define SS_DOUBLE 0
+#define SS_SINGLE 1
+#define SS_INT8 2
+#define SS_UINT8 3
+#define SS_INT16 4
+#define SS_UINT16 5
+#define SS_INT32 6
+#define SS_UINT32 7
+#define SS_BOOLEAN 8
 
 /* Block parameters as the harness makes them: char row vectors or real scalars. */
 typedef struct mxArray {
@@ -64,8 +78,9 @@ typedef struct SimStruct {
   int n_in, n_out;
   int in_width[HARNESS_MAX], out_width[HARNESS_MAX];
   int in_direct_feedthrough[HARNESS_MAX], in_contiguous[HARNESS_MAX];
-  real_T* in_signal[HARNESS_MAX];
-  real_T* out_signal[HARNESS_MAX];
+  DTypeId in_dtype[HARNESS_MAX], out_dtype[HARNESS_MAX]; /* SS_DOUBLE unless set */
+  void* in_signal[HARNESS_MAX];  /* contiguous, of the port's data type */
+  void* out_signal[HARNESS_MAX];
   int n_sample_times;
   double sample_time[HARNESS_MAX], offset_time[HARNESS_MAX];
   int n_rwork, n_iwork, n_pwork, n_modes, n_zcs;
@@ -81,6 +96,7 @@ typedef struct SimStruct {
 #define UNUSED_ARG(x) ((void)(x))
 
 #define ssGetPath(S) ((S)->path)
+/* -1: a variable number of parameters, which the S-function checks itself. */
 #define ssSetNumSFcnParams(S, n) ((S)->n_params_expected = (n))
 #define ssGetNumSFcnParams(S) ((S)->n_params_expected)
 #define ssGetSFcnParamsCount(S) ((S)->n_params_given)
@@ -97,7 +113,13 @@ typedef struct SimStruct {
 #define ssSetInputPortDirectFeedThrough(S, p, v) ((S)->in_direct_feedthrough[p] = (v))
 #define ssSetInputPortRequiredContiguous(S, p, v) ((S)->in_contiguous[p] = (v))
 #define ssGetInputPortRealSignal(S, p) ((const real_T*)(S)->in_signal[p])
-#define ssGetOutputPortRealSignal(S, p) ((S)->out_signal[p])
+#define ssGetOutputPortRealSignal(S, p) ((real_T*)(S)->out_signal[p])
+#define ssGetInputPortSignal(S, p) ((const void*)(S)->in_signal[p])
+#define ssGetOutputPortSignal(S, p) ((S)->out_signal[p])
+#define ssSetInputPortDataType(S, p, t) ((S)->in_dtype[p] = (t))
+#define ssSetOutputPortDataType(S, p, t) ((S)->out_dtype[p] = (t))
+#define ssGetNumInputPorts(S) ((S)->n_in)
+#define ssGetNumOutputPorts(S) ((S)->n_out)
 #define ssSetNumSampleTimes(S, n) ((S)->n_sample_times = (n))
 #define ssSetSampleTime(S, i, t) ((S)->sample_time[i] = (t))
 #define ssSetOffsetTime(S, i, t) ((S)->offset_time[i] = (t))

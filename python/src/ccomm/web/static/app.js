@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm live view: a small Foxglove WebSocket protocol client (the same server Foxglove
+// connects to), a status table and one uPlot chart per plotted signal.
+"use strict";
+
+// The same protocol under its two names: foxglove-sdk servers take the first, older ones
+// (foxglove_bridge 0.8, the ws-protocol reference servers) the second.
+const SUBPROTOCOLS = ["foxglove.sdk.v1", "foxglove.websocket.v1"];
+const OP_MESSAGE_DATA = 1, OP_TIME = 2;     // binary opcodes of the protocol
+const SILENT_MS = 3000;                      // no message for this long: "no update"
+const MAX_POINTS = 5000;                     // per chart; older points fall off first
+const params = new URLSearchParams(location.search);
+const windowSeconds = Number(params.get("window")) || 30;
+
+const view = {           // also what the browser test inspects
+  config: null, connected: false, rows: {}, charts: {}, received: 0, connections: 0,
+  plot: new Set(),
+};
+window.ccommView = view;
+
+const $ = (sel) => document.querySelector(sel);
+
+function showError(text) {
+  const e = $("#error");
+  e.textContent = text;
+  e.hidden = !text;
+}
+
+function setConn(state) {
+  const c = $("#conn");
+  c.className = "conn " + state;
+  c.textContent = state;
+  view.connected = state === "connected";
+}
+
+function formatValue(v) {
+  if (v === null || v === undefined) return "–";
+  if (Array.isArray(v)) return "[" + v.map(formatValue).join(", ") + "]";
+  if (typeof v === "number" && !Number.isInteger(v)) return v.toPrecision(6).replace(/\.?0+$/, "");
+  return String(v);
+}
+
+function formatAge(ns) {
+  if (ns === null || ns === undefined) return "–";
+  const ms = ns / 1e6;
+  return ms < 1000 ? ms.toFixed(1) + " ms" : (ms / 1000).toFixed(1) + " s";
+}
+
+// ---- table ---------------------------------------------------------------------------
+
+function buildTable(cfg) {
+  const body = $("#signals tbody");
+  body.textContent = "";
+  for (const s of cfg.signals) {
+    const tr = document.createElement("tr");
+    tr.dataset.signal = s.name;
+    const type = s.type + (s.count !== 1 ? "[" + s.count + "]" : "") + (s.event ? " event" : "");
+    tr.innerHTML = '<td><input type="checkbox"></td><td class="name"></td><td class="type"></td>' +
+      '<td><span class="badge never status">never</span></td><td class="value num">–</td>' +
+      '<td class="seq num">–</td><td class="age num">–</td><td class="lost num">0</td><td class="msgs num">0</td>';
+    tr.querySelector(".name").textContent = s.name;
+    tr.querySelector(".type").textContent = type;
+    const box = tr.querySelector("input");
+    box.checked = view.plot.has(s.name);
+    box.addEventListener("change", () => {
+      if (box.checked) view.plot.add(s.name); else view.plot.delete(s.name);
+      buildCharts();
+    });
+    body.appendChild(tr);
+    view.rows[s.name] = { tr, signal: s, last: null, lastAt: 0, msgs: 0 };
+  }
+}
+
+function updateRow(row) {
+  const m = row.last, tr = row.tr;
+  const silent = row.lastAt > 0 && performance.now() - row.lastAt > SILENT_MS;
+  const status = silent ? "silent" : (m ? m.status : "never");
+  const badge = tr.querySelector(".status");
+  badge.className = "badge status " + status;
+  badge.textContent = silent ? "no update" : status;
+  tr.dataset.status = status;
+  if (!m) return;
+  tr.querySelector(".value").textContent = formatValue(m.value);
+  tr.querySelector(".seq").textContent = String(m.seq);
+  tr.querySelector(".age").textContent = formatAge(m.age_ns);
+  const lost = tr.querySelector(".lost");
+  lost.textContent = String(m.lost);
+  lost.classList.toggle("nonzero", m.lost > 0);
+  tr.querySelector(".msgs").textContent = String(row.msgs);
+}
+
+// ---- charts --------------------------------------------------------------------------
+
+const PALETTE = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2"];
+
+function seriesCount(s) { return Math.min(s.count, 8); }
+
+function buildCharts() {
+  const box = $("#charts");
+  for (const c of Object.values(view.charts)) c.plot && c.plot.destroy();
+  box.textContent = "";
+  view.charts = {};
+  if (typeof uPlot === "undefined") {
+    showError("uPlot is not installed on the server (ccomm-web --help, Assets): no plots, the table still works.");
+    return;
+  }
+  for (const name of view.plot) {
+    const row = view.rows[name];
+    if (!row) continue;
+    const s = row.signal, n = seriesCount(s);
+    const div = document.createElement("div");
+    div.className = "chart";
+    div.dataset.signal = name;
+    div.innerHTML = '<h2><span class="title"></span><span class="badge never status">never</span></h2>';
+    div.querySelector(".title").textContent = name;
+    box.appendChild(div);
+    const series = [{ label: "time" }];
+    for (let i = 0; i < n; i++) {
+      const line = { label: s.count === 1 ? "value" : name + "[" + i + "]", stroke: PALETTE[i % PALETTE.length],
+                     width: 1.5, points: { show: false } };
+      if (s.event) Object.assign(line, { paths: () => null, points: { show: true, size: 7, fill: line.stroke } });
+      series.push(line);  // events are points: nothing happened between two of them
+    }
+    const data = [[]];
+    for (let i = 0; i < n; i++) data.push([]);
+    const plot = new uPlot({ width: Math.max(420, div.clientWidth - 8), height: 220, series,
+      scales: { x: { time: true } }, axes: [{}, { size: 60 }], legend: { show: s.count !== 1 },
+      cursor: { show: true } }, data, div);
+    view.charts[name] = { div, plot, data, dirty: true, points: 0 };
+  }
+}
+
+function addPoint(name, tSeconds, value) {
+  const c = view.charts[name];
+  if (!c) return;
+  const values = Array.isArray(value) ? value : [value];
+  c.data[0].push(tSeconds);
+  for (let i = 1; i < c.data.length; i++) {
+    const v = values[i - 1];
+    c.data[i].push(typeof v === "boolean" ? (v ? 1 : 0) : (v === undefined ? null : v));
+  }
+  const cut = tSeconds - windowSeconds;
+  let drop = 0;
+  while (drop < c.data[0].length && (c.data[0][drop] < cut || c.data[0].length - drop > MAX_POINTS)) drop++;
+  if (drop) for (const col of c.data) col.splice(0, drop);
+  c.points++;
+  c.dirty = true;
+}
+
+function redraw() {
+  for (const [name, c] of Object.entries(view.charts)) {
+    const row = view.rows[name];
+    const badge = c.div.querySelector(".status");
+    const status = row.tr.dataset.status || "never";
+    badge.className = "badge status " + status;
+    badge.textContent = status === "silent" ? "no update" : status;
+    if (!c.dirty) continue;
+    c.plot.setData(c.data);
+    c.dirty = false;
+    const col = c.data[1];
+    c.div.dataset.points = String(c.data[0].length);
+    c.div.dataset.last = col.length ? String(col[col.length - 1]) : "";
+  }
+}
+
+// ---- protocol client -----------------------------------------------------------------
+
+let ws = null, retryMs = 500;
+const channels = new Map();      // channel id -> signal name
+const subscriptions = new Map(); // subscription id -> signal name
+let nextSubId = 1;
+
+function connect() {
+  const url = "ws://" + location.hostname + ":" + view.config.ws_port;
+  setConn("connecting");
+  ws = new WebSocket(url, SUBPROTOCOLS);
+  ws.binaryType = "arraybuffer";
+  ws.onopen = () => { setConn("connected"); retryMs = 500; view.connections++; showError(""); };
+  ws.onclose = () => {
+    setConn("disconnected");
+    channels.clear();
+    subscriptions.clear();
+    setTimeout(connect, retryMs);   // the server restarted or the network blinked: try again
+    retryMs = Math.min(retryMs * 2, 5000);
+  };
+  ws.onerror = () => showError("cannot reach the Foxglove WebSocket server at " + url + "; retrying");
+  ws.onmessage = (ev) => (typeof ev.data === "string" ? onText(ev.data) : onBinary(ev.data));
+}
+
+function onText(text) {
+  let msg;
+  try { msg = JSON.parse(text); } catch (e) { showError("bad message from server: " + e); return; }
+  if (msg.op === "advertise") {
+    const subs = [];
+    for (const ch of msg.channels) {
+      const name = ch.topic.startsWith("/ccomm/") ? ch.topic.slice(7) : null;
+      if (!name || !view.rows[name] || ch.encoding !== "json") continue;
+      channels.set(ch.id, name);
+      const id = nextSubId++;
+      subscriptions.set(id, name);
+      subs.push({ id, channelId: ch.id });
+    }
+    if (subs.length) ws.send(JSON.stringify({ op: "subscribe", subscriptions: subs }));
+  } else if (msg.op === "unadvertise") {
+    for (const id of msg.channelIds) channels.delete(id);
+  } else if (msg.op === "status" && msg.level >= 1) {
+    showError("server: " + msg.message);
+  }
+}
+
+const decoder = new TextDecoder();
+
+function onBinary(buf) {
+  const dv = new DataView(buf);
+  const op = dv.getUint8(0);
+  if (op === OP_TIME) {
+    const t = Number(dv.getBigUint64(1, true)) / 1e9;
+    $("#clock").textContent = new Date(t * 1000).toISOString().slice(11, 23);
+    return;
+  }
+  if (op !== OP_MESSAGE_DATA) return;
+  const name = subscriptions.get(dv.getUint32(1, true));
+  if (!name) return;
+  const t = Number(dv.getBigUint64(5, true)) / 1e9;
+  let m;
+  try { m = JSON.parse(decoder.decode(new Uint8Array(buf, 13))); } catch (e) { return; }
+  const row = view.rows[name];
+  row.last = m;
+  row.lastAt = performance.now();
+  row.msgs++;
+  view.received++;
+  if (m.status !== "never") addPoint(name, t, m.value);
+  row.dirtyRow = true;
+}
+
+function tick() {   // ~10 Hz: the table and the charts follow without redrawing per message
+  for (const row of Object.values(view.rows)) {
+    if (row.dirtyRow || row.lastAt) { updateRow(row); row.dirtyRow = false; }
+  }
+  redraw();
+}
+
+async function start() {
+  try {
+    const r = await fetch("/config.json", { cache: "no-store" });
+    view.config = await r.json();
+  } catch (e) {
+    showError("cannot load /config.json from the ccomm-web server: " + e);
+    setConn("disconnected");
+    return;
+  }
+  $("#node").textContent = "node " + view.config.node;
+  const chosen = params.get("plot");
+  for (const n of chosen !== null ? chosen.split(",").filter(Boolean) : view.config.plot) view.plot.add(n);
+  buildTable(view.config);
+  buildCharts();
+  connect();
+  setInterval(tick, 100);
+}
+
+start();

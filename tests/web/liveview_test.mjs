@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: Apache-2.0
+// End-to-end test of ccomm-web: Foxglove's own protocol client (foxglove_probe.mjs) and the
+// page in real headless Chromium (playwright-core, the Debian chromium), against a running
+// ccommd and ccomm-web that tests/web/run started. Prints TAP and a "N passed, N failed" line.
+// Environment: WEB_URL, WS_URL, CCOMM (the ccomm CLI), CCOMM_NODE, PYTHON, WRITER,
+// CHROMIUM, SCREENSHOT (where the screenshot goes).
+import { execFileSync, spawn } from "node:child_process";
+import { chromium } from "playwright-core";
+import WebSocket from "ws";
+import { FoxgloveProbe } from "./foxglove_probe.mjs";
+
+const env = (k) => { if (!process.env[k]) throw new Error("missing environment " + k); return process.env[k]; };
+const WEB_URL = env("WEB_URL"), WS_URL = env("WS_URL"), NODE = env("CCOMM_NODE");
+const WRITER_RATE = 50, WRITER_COUNT = 400;  // 8 s of tick = 1..400
+
+let passed = 0, failed = 0, n = 0;
+async function check(name, fn) {
+  n++;
+  try {
+    await fn();
+    passed++;
+    console.log(`ok ${n} - ${name}`);
+  } catch (e) {
+    failed++;
+    console.log(`not ok ${n} - ${name}\n  # ${String(e && e.stack || e).split("\n").join("\n  # ")}`);
+  }
+}
+function assert(cond, what) { if (!cond) throw new Error(what); }
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+async function until(fn, timeoutMs, what) {
+  const deadline = Date.now() + timeoutMs;
+  let last;
+  while (Date.now() < deadline) {
+    last = await fn();
+    if (last) return last;
+    await sleep(50);
+  }
+  throw new Error(`timed out after ${timeoutMs} ms waiting for ${what}`);
+}
+const pub = (signal, ...values) => execFileSync(env("CCOMM"), ["--node", NODE, "pub", signal, ...values.map(String)]);
+const stats = async () => (await fetch(new URL("/stats.json", WEB_URL))).json();
+
+const LAUNCH = {
+  executablePath: env("CHROMIUM"), headless: true,
+  // playwright adds --headless and a new empty --user-data-dir itself
+  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+         "--disable-component-update", "--disable-sync"],
+};
+
+async function openPage(browser, requests) {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+  page.on("request", (r) => requests.push(r.url()));
+  page.on("pageerror", (e) => console.log("  # page error: " + e));
+  const resp = await page.goto(WEB_URL, { waitUntil: "load" });
+  assert(resp.ok(), "GET / answered " + resp.status());
+  return page;
+}
+const domRow = (page, signal) => page.evaluate((s) => {
+  const tr = document.querySelector(`#signals tr[data-signal="${s}"]`);
+  if (!tr) return null;
+  const chart = document.querySelector(`.chart[data-signal="${s}"]`);
+  const c = window.ccommView.charts[s];
+  return { status: tr.querySelector(".status").textContent, value: tr.querySelector(".value").textContent,
+           seq: tr.querySelector(".seq").textContent, lost: tr.querySelector(".lost").textContent,
+           chartLast: chart ? chart.dataset.last : null, chartPoints: chart ? Number(chart.dataset.points || 0) : 0,
+           plotted: c ? c.plot.data[1].slice(-1)[0] : undefined, series: c ? c.plot.series.length - 1 : 0 };
+}, signal);
+const canvasPixels = (page, signal) => page.evaluate((s) =>
+  document.querySelector(`.chart[data-signal="${s}"] canvas`).toDataURL(), signal);
+
+const probe = new FoxgloveProbe(WS_URL);
+let browser, page, browser2;
+const requests = [];
+const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "unused_sp", "mode_request"].map((s) => "/ccomm/" + s);
+
+await check("protocol client: every signal advertised as a JSON channel with a jsonschema", async () => {
+  await probe.connect();
+  assert(probe.serverInfo && probe.serverInfo.name.includes(NODE), "serverInfo names the node: " + JSON.stringify(probe.serverInfo));
+  for (const t of topics) {
+    const ch = probe.channels.get(t);
+    assert(ch, "advertised: " + t);
+    assert(ch.encoding === "json" && ch.schemaEncoding === "jsonschema", t + ": " + ch.encoding + "/" + ch.schemaEncoding);
+    const schema = JSON.parse(ch.schema);
+    for (const f of ["value", "seq", "source_time_ns", "age_ns", "status", "lost"]) assert(schema.properties[f], t + " schema lacks " + f);
+  }
+  const joint = JSON.parse(probe.channels.get("/ccomm/joint_pos").schema).properties.value;
+  assert(joint.type === "array" && joint.maxItems === 3 && joint.items.type === "number", "joint_pos value schema " + JSON.stringify(joint));
+  assert(JSON.parse(probe.channels.get("/ccomm/tick").schema).properties.value.type === "integer", "tick is integer");
+  for (const t of topics) probe.subscribe(t);
+});
+
+await check("protocol client: a never-written signal decodes as status never, seq 0, age null", async () => {
+  const m = await probe.waitFor("/ccomm/unused_sp", () => true, 3000, "any message");
+  assert(m.status === "never" && m.seq === 0 && m.age_ns === null && m.lost === 0, JSON.stringify(m));
+});
+
+await check("page loads in headless Chromium, from the server only (no other origin)", async () => {
+  browser = await chromium.launch(LAUNCH);
+  page = await openPage(browser, requests);
+  assert(await page.evaluate(() => typeof uPlot === "function"), "uPlot loaded from /vendor");
+  const origin = new URL(WEB_URL).origin;
+  const foreign = requests.filter((u) => !u.startsWith(origin) && !u.startsWith(WS_URL));
+  assert(foreign.length === 0, "requests elsewhere: " + foreign.join(" "));
+});
+
+await check("page connects over the Foxglove protocol and lists every signal", async () => {
+  await until(() => page.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "#conn connected");
+  const rows = await page.evaluate(() => [...document.querySelectorAll("#signals tbody tr")].map((tr) => tr.dataset.signal));
+  assert(rows.length === 6, "rows: " + rows);
+  await until(async () => (await domRow(page, "unused_sp")).status === "never", 3000, "unused_sp never");
+});
+
+await check("the plot follows a value written with ccomm pub (DOM, plot data and pixels)", async () => {
+  pub("wheel_pos", 1.25);
+  await until(async () => { const r = await domRow(page, "wheel_pos"); return r.value === "1.25" && r.plotted === 1.25 && r.status === "fresh"; },
+    5000, "wheel_pos 1.25 fresh in table and plot");
+  await sleep(300);
+  const before = await canvasPixels(page, "wheel_pos");
+  pub("wheel_pos", -2.5);
+  const r = await until(async () => { const r = await domRow(page, "wheel_pos"); return r.value === "-2.5" && r.chartLast === "-2.5" && r; },
+    5000, "wheel_pos -2.5 in table and plot");
+  assert(r.chartPoints >= 2, "points " + r.chartPoints);
+  await sleep(200);
+  assert((await canvasPixels(page, "wheel_pos")) !== before, "the chart's pixels did not change");
+  const m = await probe.waitFor("/ccomm/wheel_pos", (m) => m.value === -2.5, 3000, "value -2.5");
+  assert(m.status === "fresh" && m.seq >= 2, JSON.stringify(m));
+});
+
+await check("a signal that is not written goes stale: badge and protocol message say so", async () => {
+  const r = await until(async () => { const r = await domRow(page, "wheel_pos"); return r.status === "stale" && r; }, 3000, "wheel_pos stale");
+  assert(r.value === "-2.5", "stale value " + r.value);
+  const m = await probe.waitFor("/ccomm/wheel_pos", (m) => m.status === "stale" && m.value === -2.5, 3000, "-2.5 stale");
+  assert(m.age_ns >= 300e6, JSON.stringify(m));
+});
+
+// The writer runs while the first browser is killed: the probe must miss nothing.
+const c0 = (await stats()).changes.tick;
+const seq0 = (probe.last("/ccomm/tick") || { seq: 0 }).seq;
+const writer = spawn(env("PYTHON"), [env("WRITER"), NODE, String(WRITER_RATE), String(WRITER_COUNT)], { stdio: ["ignore", "pipe", "inherit"] });
+let writerOut = "";
+writer.stdout.on("data", (d) => { writerOut += d; });
+const writerDone = new Promise((r) => writer.on("exit", (code) => r(code)));
+
+await check("arrays and events are plotted live; screenshot taken", async () => {
+  await until(async () => (await domRow(page, "joint_pos")).chartPoints >= 20, 5000, "joint_pos points");
+  const r = await domRow(page, "joint_pos");
+  assert(r.series === 3 && r.value.startsWith("["), JSON.stringify(r));
+  await until(async () => (await domRow(page, "mode_request")).chartPoints >= 2, 5000, "mode_request events plotted");
+  await sleep(1500);
+  await page.screenshot({ path: env("SCREENSHOT"), fullPage: true });
+});
+
+await check("a browser killed mid-stream: the server goes on, a second browser is served", async () => {
+  const before = await stats();
+  assert(before.clients === 2, "clients before " + JSON.stringify(before));
+  // playwright-core has no handle on the process any more: the browser is our only chromium child
+  const pids = execFileSync("pgrep", ["-P", String(process.pid), "chromium"]).toString().trim().split("\n");
+  assert(pids.length === 1 && Number(pids[0]) > 0, "chromium children: " + pids);
+  process.kill(Number(pids[0]), "SIGKILL");
+  await until(async () => (await stats()).clients === 1, 5000, "the killed browser's subscriptions dropped");
+  browser2 = await chromium.launch(LAUNCH);
+  const page2 = await openPage(browser2, []);
+  await until(() => page2.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "second page connected");
+  const a = await until(async () => { const r = await domRow(page2, "tick"); return Number(r.value) > 0 && r; }, 5000, "tick on page 2");
+  await sleep(600);
+  const b = await domRow(page2, "tick");
+  assert(Number(b.value) > Number(a.value) && b.plotted > a.plotted, `tick did not advance on page 2: ${a.value} -> ${b.value}`);
+});
+
+await check("bad protocol input from a client: refused, server still serves", async () => {
+  const raw = new WebSocket(WS_URL, ["foxglove.sdk.v1", "foxglove.websocket.v1"]);
+  await new Promise((res, rej) => { raw.on("open", res); raw.on("error", rej); });
+  raw.send("{not json");
+  raw.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: 999999 }] }));
+  raw.send(JSON.stringify({ op: "no-such-op" }));
+  raw.send(Buffer.from([0x01, 0xff, 0xff]));
+  await sleep(300);
+  raw.terminate();
+  const n0 = probe.received("/ccomm/tick").length;
+  await until(() => probe.received("/ccomm/tick").length > n0 + 5, 3000, "probe still receiving");
+});
+
+await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {
+  const code = await writerDone;
+  assert(code === 0 && writerOut.includes("writer: done " + WRITER_COUNT), "writer exit " + code + ": " + writerOut);
+  await probe.waitFor("/ccomm/tick", (m) => m.value === WRITER_COUNT, 3000, "the last tick");
+  await sleep(300);
+  const c1 = (await stats()).changes.tick;
+  const ticks = probe.received("/ccomm/tick").map((m) => m.msg).filter((m) => m.seq > seq0);
+  const seqs = [...new Set(ticks.map((m) => m.seq))];
+  for (let i = 1; i < ticks.length; i++) assert(ticks[i].seq >= ticks[i - 1].seq, "seq went back at " + i);
+  assert(seqs.length === c1 - c0, `probe saw ${seqs.length} new tick values, the server published ${c1 - c0}`);
+  console.log(`  # tick: ${WRITER_COUNT} written at ${WRITER_RATE} Hz, ${c1 - c0} sampled and published, all received`);
+  const events = probe.received("/ccomm/mode_request").map((m) => m.msg.value);
+  const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
+  assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
+  assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));
+});
+
+probe.close();
+if (browser2) await browser2.close();
+if (browser && browser.isConnected()) await browser.close().catch(() => {});
+console.log(`1..${n}`);
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);

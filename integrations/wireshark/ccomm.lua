@@ -21,6 +21,11 @@ local F_HEARTBEAT, F_AUTH, F_KNOWN = 0x01, 0x02, 0x03
 local E_EVENT, E_KNOWN = 0x01, 0x01
 local DEST_ALL = 0xFFFF
 
+-- Lua 5.2 (Wireshark up to 4.2) has bit32; 5.3 and later have the operators instead (a
+-- syntax error for 5.2's parser, hence load()).
+local band = bit32 and bit32.band or load("return function(a, b) return a & b end")()
+local bxor = bit32 and bit32.bxor or load("return function(a, b) return a ~ b end")()
+
 -- code -> name, element size (docs/protocol.md "Types")
 local TYPES = {
   [1] = { name = "bool", size = 1 },
@@ -116,7 +121,7 @@ end
 local function fnv1a32(text)
   local h = 2166136261
   for i = 1, #text do
-    h = bit32.bxor(h, text:byte(i))
+    h = bxor(h, text:byte(i))
     -- h * 16777619 mod 2^32 without losing bits in a double: 16777619 = 2^24 + 403
     h = ((h % 256) * 16777216 + h * 403) % 4294967296
   end
@@ -258,7 +263,7 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   local t = TYPES[code]
   sub:set_text(string.format("entry %d: signal %d%s, %s%s, %s, seq %d", index, signal,
     sig and " (" .. sig.name .. ")" or "", t and t.name or "type " .. code, count ~= 1 and "[" .. count .. "]" or "",
-    bit32.band(eflags, E_EVENT) ~= 0 and "event" or "state", tvb(off + 8, 4):uint()))
+    band(eflags, E_EVENT) ~= 0 and "event" or "state", tvb(off + 8, 4):uint()))
   sub:add(f.e_signal, tvb(off, 2))
   if sig then sub:add(f.e_signal_name, tvb(off, 2), sig.name):set_generated() end
   local type_item = sub:add(f.e_type, tvb(off + 2, 1))
@@ -276,8 +281,8 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   local ok = true
   local function fail(item, text) ok = false; bad(item, text) end
   if not t then fail(type_item, "unknown type " .. code) end
-  if bit32.band(eflags, bit32.bnot(E_KNOWN)) ~= 0 then
-    fail(flags_item, string.format("unknown entry flag bits 0x%02x", bit32.band(eflags, 0xFE)))
+  if band(eflags, 0xFF - E_KNOWN) ~= 0 then
+    fail(flags_item, string.format("unknown entry flag bits 0x%02x", band(eflags, 0xFE)))
   end
   if count == 0 then fail(count_item, "count 0") end
   if t and count > 0 and value_len ~= count * t.size then
@@ -311,7 +316,7 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
     elseif config.node_ids[want.producer] ~= sender then why = "produced by " .. want.producer .. ", not by the sender"
     elseif want.type ~= code then why = "signals.xml says type " .. want.type_name
     elseif want.count ~= count then why = "signals.xml says count " .. want.count
-    elseif (want.kind == "event") ~= (bit32.band(eflags, E_EVENT) ~= 0) then why = "signals.xml says kind " .. want.kind end
+    elseif (want.kind == "event") ~= (band(eflags, E_EVENT) ~= 0) then why = "signals.xml says kind " .. want.kind end
     if why then sub:add_proto_expert_info(E.bad_signal, "bad_signal: " .. why) end
   end
   return size
@@ -328,7 +333,7 @@ local function dissect(tvb, pinfo, tree)
   -- TrimEthernetPadding() does (protocol.md "Transport encapsulation"). UDP has none.
   local flen = rlen
   if not over_udp and rlen >= HEADER and rlen <= ETH_MIN_PAYLOAD and clen == rlen then
-    local declared = HEADER + tvb(26, 2):uint() + (bit32.band(tvb(5, 1):uint(), F_AUTH) ~= 0 and TAG_SIZE or 0)
+    local declared = HEADER + tvb(26, 2):uint() + (band(tvb(5, 1):uint(), F_AUTH) ~= 0 and TAG_SIZE or 0)
     if declared < rlen and all_zero(tvb, declared, rlen - declared) then flen = declared end
   end
 
@@ -371,8 +376,8 @@ local function dissect(tvb, pinfo, tree)
   local sender, seq = tvb(6, 2):uint(), tvb(12, 4):uint()
   local entry_count, payload_len = tvb(24, 2):uint(), tvb(26, 2):uint()
   local dest, reserved = tvb(28, 2):uint(), tvb(30, 2):uint()
-  local heartbeat = bit32.band(flags, F_HEARTBEAT) ~= 0
-  local auth = bit32.band(flags, F_AUTH) ~= 0
+  local heartbeat = band(flags, F_HEARTBEAT) ~= 0
+  local auth = band(flags, F_AUTH) ~= 0
 
   local magic_item = root:add(f.magic, tvb(0, 4))
   local version_item = root:add(f.version, tvb(4, 1))
@@ -406,8 +411,8 @@ local function dissect(tvb, pinfo, tree)
   end
 
   -- 3. the header's own rules
-  if bit32.band(flags, bit32.bnot(F_KNOWN)) ~= 0 then
-    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", bit32.band(flags, 0xFC)))
+  if band(flags, 0xFF - F_KNOWN) ~= 0 then
+    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", band(flags, 0xFC)))
   end
   if reserved ~= 0 then problem(ctx, res_item, "bad_header", string.format("reserved not 0 (0x%04x)", reserved)) end
   if heartbeat and (entry_count ~= 0 or payload_len ~= 0) then

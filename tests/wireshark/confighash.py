@@ -5,6 +5,9 @@ examples/, a frame carrying the hash `ccommd --check` prints must show no config
 with that file loaded, and a frame carrying another hash must show one.
 
   confighash.py WORKDIR BIN_DIR
+
+Also the other two preferences: ccomm.udp_port and ccomm.ethertype move the dissector
+to a configuration's <network udp_port=... ethertype=...>.
 """
 import glob
 import os
@@ -48,6 +51,18 @@ def main():
         print("%s - %s: the dissector's hash equals ccommd's (%08x)%s"
               % ("ok" if ok else "not ok", name, h, "" if ok else ": %s" % msgs))
         failed |= not ok
+    # a bad-magic frame on another UDP port (the heuristic does not claim it) and a
+    # heartbeat on another EtherType: ccomm only with the preferences set
+    bad_magic = bytearray(heartbeat(0))
+    bad_magic[3] ^= 0x0F
+    pcap = os.path.join(work, "prefs.pcap")
+    wslib.write_pcap(pcap, [wslib.udp(bytes(bad_magic), port=40001), wslib.ethernet(heartbeat(0), ethertype=0x88B6)])
+    names = ["ccomm.magic"]
+    plain, _ = ts.fields(pcap, names)
+    moved, _ = ts.fields(pcap, names, ["-o", "ccomm.udp_port:40001", "-o", "ccomm.ethertype:%d" % 0x88B6])
+    ok = [("ccomm.magic" in p) for p in plain] == [False, False] and [("ccomm.magic" in p) for p in moved] == [True, True]
+    print("%s - preferences ccomm.udp_port and ccomm.ethertype move the dissector" % ("ok" if ok else "not ok"))
+    failed |= not ok
     return 1 if failed else 0
 
 

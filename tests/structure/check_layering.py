@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""The core's layering, checked on the sources and on the built libraries.
+
+  check_layering.py SOURCE_DIR BUILD_DIR
+
+- store/ and wire/ are bottom modules: their files include only the platform layer
+  (common/), their own module and system headers;
+- their static libraries use no symbol that config, daemon or client define;
+- libccomm.so (the client library every application loads) carries no XML parser:
+  no RapidXML, no configuration parser, no config library symbol, and needs no library
+  beyond the C/C++ runtime.
+Exit 0 if all hold; 1 with one line per violation.
+"""
+import os
+import re
+import subprocess
+import sys
+
+BOTTOM = {"store": {"store", "common"}, "wire": {"wire", "common"}}
+UPPER = ("config", "daemon", "client")
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+
+
+def nm(path, *flags):
+    out = subprocess.run(["nm", "-C", *flags, path], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                         text=True, check=True).stdout
+    syms = set()
+    for line in out.splitlines():
+        parts = line.split(None, 2)
+        if len(parts) == 3 and parts[1] in "TDBRWVtdbrwv":
+            syms.add(parts[2])
+        elif len(parts) == 2 and parts[0] == "U":
+            syms.add(parts[1])
+    return syms
+
+
+def library(build, module, name):
+    path = os.path.join(build, "src", module, name)
+    if not os.path.exists(path):
+        sys.exit("check_layering: %s not built (build the whole tree first)" % path)
+    return path
+
+
+def main():
+    src, build = sys.argv[1], sys.argv[2]
+    errors = []
+    # 1. Includes of the bottom modules.
+    for module, allowed in BOTTOM.items():
+        mdir = os.path.join(src, "src", module)
+        for fname in sorted(os.listdir(mdir)):
+            if not fname.endswith((".h", ".cpp")) or fname.endswith("_test.cpp") or fname.startswith("fuzz_"):
+                continue  # tests and fuzz drivers may build segments/configs to exercise the module
+            text = open(os.path.join(mdir, fname), encoding="utf-8").read()
+            for inc in INCLUDE.findall(text):
+                top = inc.split("/")[0] if "/" in inc else module
+                if top not in allowed:
+                    errors.append('src/%s/%s includes "%s": %s may depend only on %s' %
+                                  (module, fname, inc, module, ", ".join(sorted(allowed))))
+    # 2. Symbols the bottom libraries use that upper modules define.
+    defined_above = {}
+    for module, lib in (("config", "libccomm_config.a"), ("daemon", "libccomm_daemon.a"),
+                        ("daemon", "libccomm_segment_builder.a")):
+        for s in nm(library(build, module, lib), "--defined-only"):
+            defined_above[s] = module
+    client_so = os.path.join(build, "lib", "libccomm.so")
+    objdir = os.path.join(build, "src", "client", "CMakeFiles", "ccomm.dir")
+    for root, _, files in os.walk(objdir):
+        for f in files:
+            if f.endswith(".o"):
+                for s in nm(os.path.join(root, f), "--defined-only"):
+                    defined_above.setdefault(s, "client")
+    for module, lib in (("store", "libccomm_store.a"), ("wire", "libccomm_wire.a")):
+        for s in sorted(nm(library(build, module, lib), "--undefined-only")):
+            if s in defined_above:
+                errors.append("%s uses %s from %s" % (lib, s, defined_above[s]))
+    # 3. libccomm.so without the parser.
+    every = nm(client_so)
+    for s in sorted(every):
+        if "rapidxml" in s or "config_detail" in s or "LoadConfig" in s or "ParseConfig" in s or "SystemConfig" in s:
+            errors.append("libccomm.so carries %s (the configuration parser belongs to ccommd)" % s)
+    config_syms = nm(library(build, "config", "libccomm_config.a"), "--defined-only")
+    shared = sorted(s for s in config_syms & every if not s.startswith(("std::", "__", "operator", "typeinfo", "vtable")))
+    for s in shared[:20]:
+        errors.append("libccomm.so carries %s from libccomm_config.a" % s)
+    needed = subprocess.run(["readelf", "-d", client_so], stdout=subprocess.PIPE, text=True, check=True).stdout
+    for lib in re.findall(r"\(NEEDED\).*\[(.+)\]", needed):
+        if not re.match(r"lib(c|m|rt|pthread|dl|stdc\+\+|gcc_s|asan|ubsan|tsan)\.so", lib) and not lib.startswith("ld-linux"):
+            errors.append("libccomm.so needs %s (only the C/C++ runtime is expected)" % lib)
+    for e in errors:
+        print("layering: " + e)
+    if not errors:
+        print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser")
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

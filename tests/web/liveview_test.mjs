@@ -5,6 +5,7 @@
 // Environment: WEB_URL, WS_URL, CCOMM (the ccomm CLI), CCOMM_NODE, PYTHON, WRITER,
 // CHROMIUM, SCREENSHOT (where the screenshot goes).
 import { execFileSync, spawn } from "node:child_process";
+import net from "node:net";
 import { chromium } from "playwright-core";
 import WebSocket from "ws";
 import { FoxgloveProbe } from "./foxglove_probe.mjs";
@@ -178,6 +179,24 @@ await check("bad protocol input from a client: refused, server still serves", as
   raw.terminate();
   const n0 = probe.received("/ccomm/tick").length;
   await until(() => probe.received("/ccomm/tick").length > n0 + 5, 3000, "probe still receiving");
+});
+
+await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page still served", async () => {
+  const { hostname, port } = new URL(WEB_URL);
+  const raw = (text) => new Promise((res, rej) => {
+    const sock = net.connect(Number(port), hostname, () => sock.end(text));
+    let out = "";
+    sock.on("data", (d) => { out += d; });
+    sock.on("end", () => res(out.split("\r\n")[0]));
+    sock.on("error", rej);
+  });
+  for (const path of ["/../../etc/passwd", "/%2e%2e/server.py", "/static/app.js", "/vendor/../cli.py", "/server.py"]) {
+    const status = await raw(`GET ${path} HTTP/1.0\r\n\r\n`);
+    assert(status.includes(" 404 "), path + ": " + status);
+  }
+  assert((await raw("JUNK\r\n\r\n")).includes(" 400 "), "junk request");
+  assert((await raw("POST / HTTP/1.0\r\nContent-Length: 0\r\n\r\n")).includes(" 501 "), "POST");
+  assert((await raw("GET /app.js HTTP/1.0\r\n\r\n")).includes(" 200 "), "/app.js");
 });
 
 await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {

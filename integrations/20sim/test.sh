@@ -102,6 +102,11 @@ echo "== 20-sim C-code target: step order and integration methods against 20-sim
 if python3 "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" \
      --ccomm-include "$here/../../src/include" --ccomm-lib "$(cd "$bin/../lib" && pwd)"; then :; else fail=1; fi
 
+echo "== 20-sim C-code target: matrix helpers (xxmatrix.c as generated)"
+if ${CC:-cc} -std=c11 -Wall -Wextra -Wshadow -Werror -I"$out/step_order/gen_Euler" -o "$out/matrix_check" \
+     "$here/test/matrix_check.c" "$out/step_order/gen_Euler/xxmatrix.c" -lm && "$out/matrix_check"; then :;
+else echo "FAIL matrix helpers"; fail=1; fi
+
 echo "== 20-sim C-code target: template language (%IF% with EQ/NEQ/NOT/AND/OR, undefined tokens)"
 if python3 "$here/test/tokensubst_check.py"; then :; else fail=1; fi
 

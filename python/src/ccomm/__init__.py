@@ -4,16 +4,22 @@
     with ccomm.Client("planner") as c:
         r = c.read("wheel0_pos")         # Reading(value, status, seq, age_ns, ...)
         c.write("wheel0_vel_sp", 0.3)
-        c.wait(timeout=0.1)              # until a signal changes
+        c.wait(timeout=0.1)              # until any signal of the node changes
+        r = c["wheel0_pos"].wait(1.0)    # until this one has a new value (or None)
+        for ev in c["mode_request"].events():   # every event as it comes
+            ...
+        r = await c["wheel0_pos"].wait_async()  # asyncio; also aevents(), dispatch_async()
 
-The library (libccomm.so) is loaded on first use: $CCOMM_LIBRARY, $CCOMM_BUILD_DIR/lib,
-the build directories of an enclosing source tree, then the system.
+The library (libccomm.so) is loaded on first use: $CCOMM_LIBRARY, the one bundled in a
+binary wheel, $CCOMM_BUILD_DIR/lib, the build directories of an enclosing source tree,
+then the system (libccomm0).
 """
-from ._native import LibraryNotFoundError, find_library
+from ._native import LibraryNotFoundError, find_library, library_path
 from .client import (
     BusyError,
     CcommError,
     Client,
+    DaemonNotRunningError,
     InvalidArgumentError,
     NotFoundError,
     NotProducerError,
@@ -29,16 +35,20 @@ from .client import (
     VersionError,
 )
 
+# The one version of the Python package: pyproject.toml reads it, and scripts/package
+# checks that it equals the CMake project version and debian/changelog.
 __version__ = "0.1.0"
 
 __all__ = [
-    "BusyError", "CcommError", "Client", "InvalidArgumentError", "LibraryNotFoundError",
+    "BusyError", "CcommError", "Client", "DaemonNotRunningError", "InvalidArgumentError",
+    "LibraryNotFoundError",
     "NotFoundError", "NotProducerError", "QueueFullError", "Reading", "RetiredError", "Signal",
     "SignalInfo", "SignalType", "Status", "SystemCallError", "TypeMismatchError", "VersionError",
-    "find_library", "open",
+    "find_library", "library_path", "open",
 ]
 
 
-def open(node: "str | None" = None, *, no_doorbell: bool = False) -> Client:  # noqa: A001
+def open(node: "str | None" = None, *, no_doorbell: bool = False,  # noqa: A001
+         check_daemon: bool = True) -> Client:
     """Client(node): attaches to the node's ccommd segment."""
-    return Client(node, no_doorbell=no_doorbell)
+    return Client(node, no_doorbell=no_doorbell, check_daemon=check_daemon)

@@ -51,12 +51,19 @@ def _repo_roots(starts: Sequence[Path]) -> list[Path]:
     return roots
 
 
-def candidates(env: Mapping[str, str], starts: Sequence[Path]) -> list[Path]:
-    """Library paths to try, in order: $CCOMM_LIBRARY, $CCOMM_BUILD_DIR/lib, the newest
-    build*/lib of an enclosing source tree. (The system search comes after these.)"""
+# Where a binary wheel carries its libccomm (scripts/package puts it there).
+BUNDLED = Path(__file__).resolve().parent / "_lib" / "libccomm.so.0"
+
+
+def candidates(env: Mapping[str, str], starts: Sequence[Path],
+               bundled: Optional[Path] = None) -> list[Path]:
+    """Library paths to try, in order: $CCOMM_LIBRARY, the library bundled in the wheel,
+    $CCOMM_BUILD_DIR/lib, the newest build*/lib of an enclosing source tree. (The system
+    search comes after these.)"""
     out: list[Path] = []
     if env.get("CCOMM_LIBRARY"):
         return [Path(env["CCOMM_LIBRARY"])]
+    out.append(BUNDLED if bundled is None else bundled)
     if env.get("CCOMM_BUILD_DIR"):
         out += [Path(env["CCOMM_BUILD_DIR"]) / "lib" / n for n in LIB_NAMES]
     builds: list[Path] = []
@@ -72,11 +79,12 @@ def candidates(env: Mapping[str, str], starts: Sequence[Path]) -> list[Path]:
 
 
 def find_library(env: Optional[Mapping[str, str]] = None,
-                 starts: Optional[Sequence[Path]] = None) -> str:
+                 starts: Optional[Sequence[Path]] = None,
+                 bundled: Optional[Path] = None) -> str:
     """Path (or soname) of libccomm to load; raises LibraryNotFoundError."""
     env = os.environ if env is None else env
     starts = [Path(__file__).resolve().parent, Path.cwd()] if starts is None else starts
-    tried = candidates(env, starts)
+    tried = candidates(env, starts, bundled)
     for p in tried:
         if p.is_file():
             return str(p)
@@ -85,21 +93,41 @@ def find_library(env: Optional[Mapping[str, str]] = None,
     system = ctypes.util.find_library("ccomm")
     if system:
         return system
+    if _loadable(LIB_NAMES[0]):  # libccomm0 without the ldconfig cache find_library reads
+        return LIB_NAMES[0]
     where = ", ".join(str(p) for p in tried) or "no build directory"
     raise LibraryNotFoundError(
         f"libccomm.so not found (tried {where}, then the system library path). "
         "Set CCOMM_LIBRARY to the library or CCOMM_BUILD_DIR to a ccomm build directory.")
 
 
+def _loadable(soname: str) -> bool:
+    try:
+        ctypes.CDLL(soname)
+        return True
+    except OSError:
+        return False
+
+
 _lib: Optional[ctypes.CDLL] = None
+_lib_path: Optional[str] = None
 
 
 def lib() -> ctypes.CDLL:
     """The loaded library, declared; loaded on first use so `import ccomm` never fails."""
-    global _lib
+    global _lib, _lib_path
     if _lib is None:
-        _lib = _declare(ctypes.CDLL(find_library()))
+        path = find_library()
+        _lib = _declare(ctypes.CDLL(path))
+        _lib_path = path
     return _lib
+
+
+def library_path() -> str:
+    """Path (or soname) of the libccomm this process uses; loads it if needed."""
+    lib()
+    assert _lib_path is not None
+    return _lib_path
 
 
 def _declare(L: ctypes.CDLL) -> ctypes.CDLL:

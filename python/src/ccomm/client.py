@@ -5,13 +5,14 @@ from __future__ import annotations
 import ctypes
 import enum
 import math
+import time
 from dataclasses import dataclass
-from typing import Any, Dict, Iterator, List, Optional, Union
+from typing import Any, AsyncIterator, Callable, Dict, Iterator, List, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
 
-from . import _native
+from . import _aio, _native
 
 Scalar = Union[bool, int, float]
 Value = Union[Scalar, "npt.NDArray[Any]"]
@@ -93,6 +94,12 @@ class RetiredError(CcommError):
     """CCOMM_E_RETIRED: ccommd replaced the segment (new configuration): reopen."""
 
 
+class DaemonNotRunningError(CcommError, ConnectionError):
+    """A write reached shared memory but ccommd is not running (no heartbeat for a
+    second): nothing forwards the value to other nodes or judges its freshness there. A
+    restarted ccommd makes a new segment; this client then gets RetiredError."""
+
+
 _ERRORS = {-1: InvalidArgumentError, -2: NotFoundError, -3: TypeMismatchError,
            -4: NotProducerError, -5: QueueFullError, -6: BusyError, -7: SystemCallError,
            -8: VersionError, -9: RetiredError}
@@ -153,6 +160,13 @@ class Signal:
         self._view: npt.NDArray[Any] = np.frombuffer(memoryview(self._buf), dtype=info.dtype,
                                                      count=info.count)
         self._cinfo = _native.Info()
+        # Sequence number of the newest value this object has handed out: wait() and
+        # events() wait for a newer one. A state starts at its current value.
+        self._last_seq = 0 if info.is_event else self._peek_seq()
+
+    def _peek_seq(self) -> int:
+        status = self._read_raw()
+        return 0 if status == Status.EMPTY else int(self._cinfo.seq)
 
     @property
     def name(self) -> str:
@@ -185,12 +199,75 @@ class Signal:
         status = self._read_raw()
         if status == Status.EMPTY:
             return self._reading(status, None)
+        return self._value_reading(status)
+
+    def _value_reading(self, status: Status) -> Reading:
+        """The Reading of what _read_raw() left in the buffer; remembers its seq."""
         value: Value
         if self.info.count == 1:
             value = self._view[0].item()
         else:
             value = self._view.copy()
+        self._last_seq = int(self._cinfo.seq)
         return self._reading(status, value)
+
+    def _take_new(self) -> Optional[Reading]:
+        """The next event, or a state value newer than the last one handed out; else None."""
+        self._cinfo.flags = 0
+        status = self._read_raw()
+        if status == Status.EMPTY:
+            return None
+        if not self.info.is_event and int(self._cinfo.seq) == self._last_seq:
+            return None
+        return self._value_reading(status)
+
+    def wait(self, timeout: Optional[float] = None) -> Optional[Reading]:
+        """Waits for this one signal: the next event, or for a state a value newer than
+        the last one this Signal returned (from read(), wait(), events() or at creation).
+        Returns its Reading, or None after `timeout` seconds (None: no limit; 0: just
+        look). Other signals' changes do not end the wait. Releases the GIL; Ctrl-C works."""
+        deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
+        while True:
+            r = self._take_new()
+            if r is not None:
+                return r
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                return None
+            self._client._wait_for_change(left)
+
+    def events(self, timeout: Optional[float] = None) -> Iterator[Reading]:
+        """Iterates over the signal's new values as they come: every event of an event
+        signal (none is lost unless the queue overruns: Reading.lost counts those), every
+        new value of a state (a state written faster than you iterate skips values). Ends
+        when nothing new comes for `timeout` seconds (None: never)."""
+        while True:
+            r = self.wait(timeout)
+            if r is None:
+                return
+            yield r
+
+    async def wait_async(self, timeout: Optional[float] = None) -> Optional[Reading]:
+        """wait() for asyncio: the coroutine sleeps, the event loop runs on."""
+        loop_deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
+        pump = self._client._pump
+        while True:
+            changed = pump.changed_event()  # before the look: a change after it sets this
+            r = self._take_new()
+            if r is not None:
+                return r
+            left = None if loop_deadline is None else loop_deadline - time.monotonic()
+            if left is not None and left <= 0:
+                return None
+            await pump.wait(changed, left)
+
+    async def aevents(self, timeout: Optional[float] = None) -> AsyncIterator[Reading]:
+        """events() for asyncio: `async for r in signal.aevents(): ...`."""
+        while True:
+            r = await self.wait_async(timeout)
+            if r is None:
+                return
+            yield r
 
     def read_into(self, out: npt.NDArray[Any]) -> Reading:
         """Reads into `out` (shape (count,), the signal's dtype), allocating no array.
@@ -226,22 +303,38 @@ class Signal:
                 if lo < info.min or hi > info.max:
                     raise OverflowError(f"{i.name}: value out of range for {i.type.name.lower()}: {value!r}")
         self._view[...] = arr.astype(i.dtype)
-        r = _native.lib().ccomm_write(self._client._handle(), i.id, self._buf, i.value_bytes)
-        _check(r, f"write {i.name}")
+        L, h = _native.lib(), self._client._handle()
+        _check(L.ccomm_write(h, i.id, self._buf, i.value_bytes), f"write {i.name}")
+        if self._client._check_daemon and not L.ccomm_daemon_alive(h):
+            raise DaemonNotRunningError(-2, f"write {i.name}: the value is in shared memory but "
+                                        f"ccommd of node {self._client.node} is not running: "
+                                        "nothing forwards it (start ccommd)")
 
 
 class Client:
     """Attached to one node's ccommd segment. Use one Client per thread (ccomm handles
     are not shared between threads). Closes on exit of a `with` block."""
 
-    def __init__(self, node: Optional[str] = None, *, no_doorbell: bool = False) -> None:
-        L = _native.lib()
-        h = ctypes.c_void_p()
-        r = L.ccomm_open(node.encode() if node is not None else None,
-                         _NO_DOORBELL if no_doorbell else 0, ctypes.byref(h))
-        _check(r, f"open node {node if node is not None else '(default)'}")
-        self._h: Optional[int] = h.value
+    def __init__(self, node: Optional[str] = None, *, no_doorbell: bool = False,
+                 check_daemon: bool = True) -> None:
+        """Attaches to `node` (None: $CCOMM_NODE, else the hostname); NotFoundError if
+        its ccommd has not made the segment. With check_daemon (the default), a write
+        while ccommd is not running raises DaemonNotRunningError after writing."""
+        self._h: Optional[int] = None
+        self._h = self._open(node, _NO_DOORBELL if no_doorbell else 0)
+        self._node_arg, self._flags, self._check_daemon = node, _NO_DOORBELL if no_doorbell else 0, check_daemon
         self._signals: Dict[str, Signal] = {}
+        self._waiter: Optional[int] = None  # the handle Signal.wait() waits on
+        self._pump = _aio.ChangePump(lambda: self._open(self._node_arg, self._flags))
+        self._callbacks: List["tuple[Signal, Callable[[Signal, Reading], Any]]"] = []
+
+    @staticmethod
+    def _open(node: Optional[str], flags: int) -> int:
+        h = ctypes.c_void_p()
+        r = _native.lib().ccomm_open(node.encode() if node is not None else None, flags, ctypes.byref(h))
+        _check(r, f"open node {node if node is not None else '(default)'}")
+        assert h.value is not None
+        return h.value
 
     def _handle(self) -> int:
         if self._h is None:
@@ -259,6 +352,10 @@ class Client:
 
     def close(self) -> None:
         if self._h is not None:
+            self._pump.close()
+            if self._waiter is not None:
+                _native.lib().ccomm_close(self._waiter)
+                self._waiter = None
             _native.lib().ccomm_close(self._h)
             self._h = None
 
@@ -327,6 +424,64 @@ class Client:
         Releases the GIL while waiting."""
         ms = -1 if timeout is None else max(0, int(math.ceil(timeout * 1000.0)))
         return _check(_native.lib().ccomm_wait(self._handle(), ms), "wait") == 1
+
+    def _wait_for_change(self, timeout: Optional[float]) -> None:
+        """One ccomm_wait() on the handle of Signal.wait(), at most 0.2 s at a time (so
+        Ctrl-C is seen); a separate handle, so Client.wait() keeps its own notion of
+        'changed since the previous wait'."""
+        self._handle()
+        if self._waiter is None:
+            self._waiter = self._open(self._node_arg, self._flags)
+        ms = 200 if timeout is None else max(0, min(200, int(math.ceil(timeout * 1000.0))))
+        _check(_native.lib().ccomm_wait(self._waiter, ms), "wait")
+
+    def on(self, name: str, callback: Callable[[Signal, Reading], Any]) -> None:
+        """Calls callback(signal, reading) from dispatch() for every new value of `name`
+        (every event of an event signal, each new value of a state)."""
+        self._callbacks.append((self.signal(name), callback))
+
+    def dispatch(self, timeout: Optional[float] = None) -> int:
+        """Waits until a signal registered with on() has something new (or `timeout`
+        seconds pass; None: no limit) and calls the callbacks for everything new, in
+        registration order, events all drained. Returns how many calls it made. Run it in
+        a loop: `while True: client.dispatch()`."""
+        if not self._callbacks:
+            raise ValueError("dispatch(): no callbacks (register them with Client.on())")
+        deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
+        while True:
+            calls = self._dispatch_round()
+            if calls:
+                return calls
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                return 0
+            self._wait_for_change(left)
+
+    def _dispatch_round(self) -> int:
+        calls = 0
+        for sig, cb in self._callbacks:
+            r = sig._take_new()
+            while r is not None:
+                cb(sig, r)
+                calls += 1
+                r = sig._take_new() if sig.info.is_event else None
+        return calls
+
+    async def dispatch_async(self, timeout: Optional[float] = None) -> int:
+        """dispatch() for asyncio: the coroutine sleeps until a registered signal has
+        something new; the callbacks run on the event loop's thread."""
+        if not self._callbacks:
+            raise ValueError("dispatch_async(): no callbacks (register them with Client.on())")
+        deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
+        while True:
+            changed = self._pump.changed_event()  # before the look (see _aio)
+            calls = self._dispatch_round()
+            if calls:
+                return calls
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                return 0
+            await self._pump.wait(changed, left)
 
     @property
     def daemon_alive(self) -> bool:

@@ -121,23 +121,31 @@ function buildCharts() {
       if (s.event) Object.assign(line, { paths: () => null, points: { show: true, size: 7, fill: line.stroke } });
       series.push(line);  // events are points: nothing happened between two of them
     }
+    // A scalar state signal gets a second, thick amber series that holds the value only
+    // while it is stale: a stale stretch stands out in the plot itself.
+    const staleSeries = s.count === 1 && !s.event;
+    if (staleSeries) series.push({ label: "stale", stroke: "#d68910", width: 4, points: { show: false }, spanGaps: false });
     const data = [[]];
-    for (let i = 0; i < n; i++) data.push([]);
+    for (let i = 1; i < series.length; i++) data.push([]);
     const plot = new uPlot({ width: Math.max(420, div.clientWidth - 8), height: 220, series,
       scales: { x: { time: true } }, axes: [{}, { size: 60 }], legend: { show: s.count !== 1 },
       cursor: { show: true } }, data, div);
-    view.charts[name] = { div, plot, data, dirty: true, points: 0 };
+    view.charts[name] = { div, plot, data, dirty: true, points: 0, staleSeries };
   }
 }
 
-function addPoint(name, tSeconds, value) {
+function addPoint(name, tSeconds, value, status) {
   const c = view.charts[name];
   if (!c) return;
-  const values = Array.isArray(value) ? value : [value];
+  const values = (Array.isArray(value) ? value : [value]).map((v) => (typeof v === "boolean" ? Number(v) : v));
   c.data[0].push(tSeconds);
-  for (let i = 1; i < c.data.length; i++) {
-    const v = values[i - 1];
-    c.data[i].push(typeof v === "boolean" ? (v ? 1 : 0) : (v === undefined ? null : v));
+  const nValues = c.data.length - 1 - (c.staleSeries ? 1 : 0);
+  for (let i = 1; i <= nValues; i++) c.data[i].push(values[i - 1] === undefined ? null : values[i - 1]);
+  if (c.staleSeries) {
+    const col = c.data[nValues + 1];
+    // the fresh point before a stale one starts the amber stretch, so it has a length
+    if (status === "stale" && col.length && col[col.length - 1] === null) col[col.length - 1] = c.data[1][col.length - 1];
+    col.push(status === "stale" ? values[0] : null);
   }
   const cut = tSeconds - windowSeconds;
   let drop = 0;
@@ -229,7 +237,7 @@ function onBinary(buf) {
   row.lastAt = performance.now();
   row.msgs++;
   view.received++;
-  if (m.status !== "never") addPoint(name, t, m.value);
+  if (m.status !== "never") addPoint(name, t, m.value, m.status);
   row.dirtyRow = true;
 }
 

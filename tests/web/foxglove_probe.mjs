@@ -34,7 +34,8 @@ export class FoxgloveProbe {
         this.errors.push("undecodable message on " + topic + ": " + e);
         return;
       }
-      this.messages.get(topic).push({ t: timestamp, msg });
+      // hrtime is CLOCK_MONOTONIC, the clock of the messages' source_time_ns
+      this.messages.get(topic).push({ t: timestamp, mono: process.hrtime.bigint(), msg });
     });
     await new Promise((resolve, reject) => {
       const timer = setTimeout(() => reject(new Error("no advertise from " + this.url)), timeoutMs);

@@ -210,6 +210,12 @@ await check("the protocol client lost nothing while the browser died (every new 
   for (let i = 1; i < ticks.length; i++) assert(ticks[i].seq >= ticks[i - 1].seq, "seq went back at " + i);
   assert(seqs.length === c1 - c0, `probe saw ${seqs.length} new tick values, the server published ${c1 - c0}`);
   console.log(`  # tick: ${WRITER_COUNT} written at ${WRITER_RATE} Hz, ${c1 - c0} sampled and published, all received`);
+  // Write-to-client latency of each new value (same host, same clock), for the docs.
+  const firsts = new Map();
+  for (const m of probe.received("/ccomm/tick")) if (m.msg.seq > seq0 && !firsts.has(m.msg.seq)) firsts.set(m.msg.seq, m);
+  const lat = [...firsts.values()].map((m) => Number(m.mono - BigInt(m.msg.source_time_ns)) / 1e6).sort((a, b) => a - b);
+  const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))].toFixed(2);
+  console.log(`  # write -> protocol client latency (ms): min ${q(0)} p50 ${q(0.5)} p99 ${q(0.99)} max ${q(1)} (n=${lat.length})`);
   const events = probe.received("/ccomm/mode_request").map((m) => m.msg.value);
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));

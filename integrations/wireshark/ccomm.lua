@@ -249,8 +249,10 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
     problem(ctx, tree, "bad_entry", string.format("entry %d: less than 24 bytes of payload left (%d)", index, left))
     return nil
   end
-  if off + ENTRY_HEADER > tvb:len() then
-    tree:add_proto_expert_info(E.note, string.format("entry %d: not in the captured bytes", index))
+  -- the frame may be shorter than it declares (too_short), or cut by the capture's snap length
+  local function missing(upto) return upto > ctx.flen and "beyond the received frame" or "not captured" end
+  if off + ENTRY_HEADER > math.min(ctx.flen, tvb:len()) then
+    tree:add_proto_expert_info(E.note, string.format("entry %d: %s", index, missing(off + ENTRY_HEADER)))
     return nil
   end
   local function bad(item, text) problem(ctx, item, "bad_entry", string.format("entry %d: %s", index, text)) end
@@ -294,8 +296,8 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
     return nil
   end
   local voff = off + ENTRY_HEADER
-  if voff + padded > tvb:len() then
-    sub:add_proto_expert_info(E.note, "value not in the captured bytes")
+  if voff + padded > math.min(ctx.flen, tvb:len()) then
+    sub:add_proto_expert_info(E.note, "value " .. missing(voff + padded))
     return size
   end
   if ok then
@@ -338,7 +340,7 @@ local function dissect(tvb, pinfo, tree)
   end
 
   local root = tree:add(ccomm, tvb(0, math.min(flen, clen)))
-  local ctx = { root = root }
+  local ctx = { root = root, flen = flen }
   local function add(field, off, size)
     if off + size <= clen then return root:add(field, tvb(off, size)) end
   end
@@ -356,8 +358,8 @@ local function dissect(tvb, pinfo, tree)
     return flen
   end
 
-  -- 1. fewer than 32 bytes
-  if flen < HEADER then
+  -- 1. fewer than 32 bytes (or fewer captured: then nothing can be checked)
+  if flen < HEADER or clen < HEADER then
     local magic_item = add(f.magic, 0, 4)
     add(f.version, 4, 1)
     add(f.flags, 5, 1)
@@ -368,7 +370,11 @@ local function dissect(tvb, pinfo, tree)
     add(f.entry_count, 24, 2)
     add(f.payload_len, 26, 2)
     add(f.dest, 28, 2)
-    problem(ctx, magic_item or root, "too_short", string.format("fewer than 32 bytes (%d)", flen))
+    if flen < HEADER then
+      problem(ctx, magic_item or root, "too_short", string.format("fewer than 32 bytes (%d)", flen))
+    else
+      root:add_proto_expert_info(E.note, string.format("header not captured (%d of 32 bytes)", clen))
+    end
     return finish(string.format("%d bytes", flen))
   end
 

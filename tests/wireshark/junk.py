@@ -8,7 +8,7 @@ Packets, half over UDP port 47800 and half over EtherType 0x88B5: random bytes o
 length (0-1500); every truncation of the largest valid vectors; valid vectors with random
 bit flips, random header and entry fields (counts, lengths, types, flags) and random
 tails; plus random UDP datagrams on another port that start with the magic (the heuristic
-path). Each is dissected fully (-V), once without and once with a signals.xml loaded.
+path). Every 7th packet is cut as by a capture's snap length (1-80 bytes into the frame). Each is dissected fully (-V), once without and once with a signals.xml loaded.
 """
 import argparse
 import os
@@ -64,17 +64,22 @@ def main():
     ts = wslib.Tshark(args.workdir)
     seeds = [v.data() for v in wire_vectors.vectors()]
     frames = mutants(rng, seeds, args.packets)
-    packets, to_ccomm = [], 0
+    packets, to_ccomm, snaplens = [], 0, []
     for i, fr in enumerate(frames):
-        if i % 10 == 9:  # heuristic path: another UDP port, frame starting with the magic
+        heuristic = i % 10 == 9  # another UDP port, a frame starting with the magic
+        if heuristic:
             fr = struct.pack(">IB", wire_vectors.MAGIC, 1) + fr[5:]
             packets.append(wslib.udp(fr, port=40000 + i % 1000))
-            to_ccomm += len(fr) >= 8  # the heuristic wants 8 bytes to claim a datagram
         else:
             packets.append(wslib.udp(fr) if i % 2 else wslib.ethernet(fr))
-            to_ccomm += len(fr) > 0  # an empty payload goes to no dissector
+        # every 7th packet as a capture with a short snap length saw it: cut 1-80 bytes
+        # into the ccomm frame (a cut before it leaves the frame to no dissector)
+        cut = rng.randrange(1, 81) if i % 7 == 6 else 65535
+        snaplens.append(len(packets[-1]) - len(fr) + cut)
+        # an empty payload goes to no dissector; the heuristic wants 8 bytes to judge
+        to_ccomm += min(len(fr), cut) >= 8 if heuristic else len(fr) > 0
     pcap = os.path.join(args.workdir, "junk.pcap")
-    wslib.write_pcap(pcap, packets)
+    wslib.write_pcap(pcap, packets, snaplens)
     config = ts.readable(os.path.join(wslib.ROOT, "dist", "signals.xml"))
     failed = 0
     for label, extra in (("no configuration", []), ("with dist/signals.xml", ["-o", "ccomm.config:" + config])):

@@ -48,13 +48,15 @@ def udp(frame, port=UDP_PORT):
     return MAC_B + MAC_A + b"\x08\x00" + ip + head + frame
 
 
-def write_pcap(path, packets):
-    """Classic pcap, link type Ethernet, one second between packets."""
+def write_pcap(path, packets, snaplens=None):
+    """Classic pcap, link type Ethernet, one second between packets. snaplens[i], when
+    given and shorter, cuts packet i as a capture with that snap length would."""
     with open(path, "wb") as f:
         f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1))
         for i, p in enumerate(packets):
-            f.write(struct.pack("<IIII", BASE_TIME + i, 0, len(p), len(p)))
-            f.write(p)
+            cap = min(len(p), snaplens[i]) if snaplens else len(p)
+            f.write(struct.pack("<IIII", BASE_TIME + i, 0, cap, len(p)))
+            f.write(p[:cap])
 
 
 class Tshark:

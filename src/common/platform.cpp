@@ -138,6 +138,12 @@ bool HostName(char* buf, size_t cap) {
   return buf[0] != '\0';
 }
 
+void SleepNs(uint64_t ns) {
+  struct timespec ts = {static_cast<time_t>(ns / 1000000000ull), static_cast<long>(ns % 1000000000ull)};
+  while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+  }
+}
+
 }  // namespace platform
 
 static LogLevel g_max_level = LogLevel::kInfo;

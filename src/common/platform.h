@@ -1,7 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// Every OS call ccomm makes goes through this header (zenoh-pico style), so a port
-// (Xenomai, another RTOS) touches one file. Functions marked [rt] are safe on a
-// real-time path: no allocation, no locks, and no syscall except where stated.
+// The platform layer (zenoh-pico style): every OS call of the store, the client library
+// and ccommd's threads (clock, futex, shared memory, scheduling, sleeping, logging) goes
+// through this header, so a port (Xenomai, another RTOS) of what runs inside the
+// applications touches one file. The daemon's Linux-only services have a file each that
+// is their platform layer: transport_raw.cpp / transport_udp.cpp (sockets),
+// privileges.cpp (capabilities, prctl), auth.cpp (the key file), config.cpp (reading
+// signals.xml). Functions marked [rt] are safe on a real-time path: no allocation, no
+// locks, and no syscall except where stated.
 #pragma once
 
 #include <cstddef>
@@ -51,6 +56,8 @@ int PinToCpu(int cpu);
 /// Packets the kernel dropped at socket `fd` since it was opened (receive buffer full;
 /// SO_MEMINFO, the `d` that `ss -m` shows). Returns 0 or -errno. Not [rt]: supervision.
 int SocketDrops(int fd, uint32_t* drops);
+/// Sleeps `ns` nanoseconds (not [rt]: a syscall; for idle and back-off waits).
+void SleepNs(uint64_t ns);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 

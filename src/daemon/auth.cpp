@@ -10,9 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#ifdef CCOMM_HAVE_SODIUM
-#include <sodium.h>
-#endif
+#include "daemon/auth_crypto.h"
 
 namespace ccomm {
 namespace auth {
@@ -25,24 +23,11 @@ int HexDigit(uint8_t c) {
   return -1;
 }
 
-void Wipe(void* p, size_t n) {
-#ifdef CCOMM_HAVE_SODIUM
-  sodium_memzero(p, n);
-#else
-  volatile uint8_t* v = static_cast<volatile uint8_t*>(p);
-  while (n--) *v++ = 0;
-#endif
-}
+void Wipe(void* p, size_t n) { crypto::Wipe(p, n); }
 
 }  // namespace
 
-bool Available() {
-#ifdef CCOMM_HAVE_SODIUM
-  return true;
-#else
-  return false;
-#endif
-}
+bool Available() { return crypto::kAvailable; }
 
 int LoadKeyFile(const std::string& path, uint8_t key[kKeyBytes], std::string* error) {
   int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
@@ -109,12 +94,10 @@ int FrameAuth::Load(const std::string& path, std::string* error) {
              "(CCOMM_WITH_SODIUM): refusing to run unauthenticated";
     return -ENOTSUP;
   }
-#ifdef CCOMM_HAVE_SODIUM
-  if (sodium_init() < 0) {
+  if (crypto::Init() != 0) {
     *error = "libsodium failed to initialise";
     return -EIO;
   }
-#endif
   uint8_t key[kKeyBytes];
   int r = LoadKeyFile(path, key, error);
   if (r != 0) return r;
@@ -129,27 +112,16 @@ void FrameAuth::SetKey(const uint8_t key[kKeyBytes]) {
 }
 
 void FrameAuth::Sign(const uint8_t* frame, size_t len, uint8_t* tag) const {
-#ifdef CCOMM_HAVE_SODIUM
-  crypto_generichash(tag, kTagBytes, frame, len, key_, kKeyBytes);
-#else
-  (void)frame;
-  (void)len;
-  memset(tag, 0, kTagBytes);  // unreachable: enabled_ is never true without libsodium
-#endif
+  crypto::Tag(frame, len, key_, tag);
 }
 
 bool FrameAuth::Accept(const uint8_t* frame, size_t len, uint8_t flags) const {
   const bool tagged = (flags & wire::kFlagAuth) != 0;
   if (!enabled_) return !tagged;
   if (!tagged || len < wire::kHeaderSize + kTagBytes) return false;
-#ifdef CCOMM_HAVE_SODIUM
   uint8_t expect[kTagBytes];
   Sign(frame, len - kTagBytes, expect);
-  return sodium_memcmp(expect, frame + len - kTagBytes, kTagBytes) == 0;
-#else
-  (void)frame;
-  return false;
-#endif
+  return crypto::TagsEqual(expect, frame + len - kTagBytes);
 }
 
 void ReplayWindow::Reset(uint32_t seq, uint64_t send_ns, uint64_t now_ns) {

@@ -124,12 +124,12 @@ void Daemon::Supervise(uint64_t now) {
     size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);
     if (freed) h->daemon_counters[store::kSlotsReclaimed].fetch_add(freed, std::memory_order_relaxed);
   }
-  if (now >= next_drops_ns_ && transport_.fd >= 0) {
+  if (now >= next_drops_ns_ && transport_.ops) {
     // Frames lost before ccommd saw them (its receive thread starved, buffer full):
     // otherwise only a sequence gap would tell, without the reason.
     next_drops_ns_ = now + 100000000ull;
     uint32_t drops = 0;
-    if (platform::SocketDrops(transport_.fd, &drops) == 0) {
+    if (transport_.SocketDrops(&drops) == 0) {
       h->daemon_counters[store::kSocketDrops].fetch_add(drops - socket_drops_seen_, std::memory_order_relaxed);
       socket_drops_seen_ = drops;
     }

@@ -127,8 +127,7 @@ void Daemon::RunRx() {
   while (running_.load(std::memory_order_relaxed)) {
     rx_loops_.fetch_add(1, std::memory_order_relaxed);
     if (!transport_.ops) {  // local-only node: nothing to receive
-      struct timespec ts = {0, opt_.recv_timeout_ms * 1000 * 1000};
-      nanosleep(&ts, nullptr);
+      platform::SleepNs(uint64_t{static_cast<uint32_t>(opt_.recv_timeout_ms)} * 1000 * 1000);
       continue;
     }
     PeerAddress from;
@@ -141,8 +140,7 @@ void Daemon::RunRx() {
       else Count(store::kRecvErrors);
       if (!bad_frame) {
         // e.g. ENETDOWN while the link is down: do not spin.
-        struct timespec ts = {0, 10 * 1000 * 1000};
-        nanosleep(&ts, nullptr);
+        platform::SleepNs(10 * 1000 * 1000);
       }
     }
   }

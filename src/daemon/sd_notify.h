@@ -1,39 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
-// systemd readiness and watchdog; compiles to nothing without libsystemd.
+// systemd readiness and watchdog, one unit per build: sd_notify_systemd.cpp (libsystemd)
+// or sd_notify_none.cpp (no service manager: every call does nothing). CMake picks it.
 #pragma once
 
 #include <cstdint>
 
-#ifdef CCOMM_HAVE_SYSTEMD
-#include <systemd/sd-daemon.h>
-#endif
-
 namespace ccomm {
 namespace sd {
 
-inline void NotifyReady() {
-#ifdef CCOMM_HAVE_SYSTEMD
-  sd_notify(0, "READY=1\nSTATUS=forwarding");
-#endif
-}
-inline void NotifyStopping() {
-#ifdef CCOMM_HAVE_SYSTEMD
-  sd_notify(0, "STOPPING=1");
-#endif
-}
-inline void NotifyWatchdog() {
-#ifdef CCOMM_HAVE_SYSTEMD
-  sd_notify(0, "WATCHDOG=1");
-#endif
-}
+void NotifyReady();
+void NotifyStopping();
+void NotifyWatchdog();
 /// Watchdog interval asked for by the unit (WatchdogSec=), 0 if none.
-inline uint64_t WatchdogIntervalNs() {
-#ifdef CCOMM_HAVE_SYSTEMD
-  uint64_t usec = 0;
-  if (sd_watchdog_enabled(0, &usec) > 0) return usec * 1000;
-#endif
-  return 0;
-}
+uint64_t WatchdogIntervalNs();
 
 }  // namespace sd
 }  // namespace ccomm

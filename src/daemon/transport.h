@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // One transport per file behind a short function table (LCM style): raw Ethernet
-// (transport_raw.cpp) and UDP (transport_udp.cpp). ccommd opens one at start-up; send
-// and recv are the only calls on its real-time paths and never allocate.
+// (transport_raw.cpp) and UDP (transport_udp.cpp). Each keeps its own state (socket,
+// interface, port) behind an opaque pointer; ccommd sees only the table. ccommd opens
+// one at start-up; send and recv are the only calls on its real-time paths and never
+// allocate. Each transport file is the platform layer of its transport (sockets).
 #pragma once
 
+#include <errno.h>
 #include <sys/types.h>
 
 #include <cstddef>
@@ -31,22 +34,23 @@ struct TransportOps {
   /// 0 on timeout, -EMSGSIZE for a frame larger than `cap`, -ENODATA for an empty one,
   /// or another -errno. `from` is filled when a frame is returned.
   ssize_t (*recv)(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from);
+  /// Frames the kernel dropped before ccommd read them (cumulative); 0 or -errno.
+  int (*socket_drops)(Transport* t, uint32_t* drops);
+  /// Closes the socket and frees the state.
   void (*close)(Transport* t);
 };
 
 struct Transport {
   const TransportOps* ops = nullptr;
-  int fd = -1;
-  int ifindex = 0;
-  uint16_t ethertype = 0;  // raw
-  uint16_t port = 0;       // UDP, network order
-  uint8_t own_mac[6] = {};
+  void* state = nullptr;  // the transport's own, allocated at open (start-up)
 
   int Send(const PeerAddress& to, const uint8_t* f, size_t n) { return ops->send(this, to, f, n); }
   ssize_t Recv(uint8_t* b, size_t cap, PeerAddress* from) { return ops->recv(this, b, cap, from); }
+  int SocketDrops(uint32_t* drops) { return ops ? ops->socket_drops(this, drops) : -EBADF; }
   void Close() {
     if (ops) ops->close(this);
     ops = nullptr;
+    state = nullptr;
   }
 };
 

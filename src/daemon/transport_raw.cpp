@@ -7,25 +7,33 @@
 #include <net/ethernet.h>
 #include <net/if.h>
 #include <string.h>
-#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "common/platform.h"
 #include "daemon/transport.h"
 #include "wire/wire.h"
 
 namespace ccomm {
 namespace {
 
+struct RawState {
+  int fd = -1;
+  int ifindex = 0;
+  uint16_t ethertype = 0;
+};
+
+RawState* State(Transport* t) { return static_cast<RawState*>(t->state); }
+
 int RawSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
   struct sockaddr_ll sll;
   memset(&sll, 0, sizeof sll);
   sll.sll_family = AF_PACKET;
-  sll.sll_ifindex = t->ifindex;
-  sll.sll_protocol = htons(t->ethertype);
+  sll.sll_ifindex = State(t)->ifindex;
+  sll.sll_protocol = htons(State(t)->ethertype);
   sll.sll_halen = 6;
   memcpy(sll.sll_addr, to.mac, 6);
-  ssize_t n = sendto(t->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll);
+  ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll);
   return n == static_cast<ssize_t>(len) ? 0 : -errno;
 }
 
@@ -33,7 +41,7 @@ ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
   for (;;) {
     struct sockaddr_ll sll;
     socklen_t sl = sizeof sll;
-    ssize_t n = recvfrom(t->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sll), &sl);
+    ssize_t n = recvfrom(State(t)->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sll), &sl);
     if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -errno;
     if (sll.sll_pkttype == PACKET_OUTGOING) continue;  // our own frames, looped back
     if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
@@ -45,12 +53,15 @@ ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
   }
 }
 
+int RawDrops(Transport* t, uint32_t* drops) { return platform::SocketDrops(State(t)->fd, drops); }
+
 void RawClose(Transport* t) {
-  if (t->fd >= 0) close(t->fd);
-  t->fd = -1;
+  RawState* st = State(t);
+  if (st->fd >= 0) close(st->fd);
+  delete st;
 }
 
-const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawClose};
+const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawDrops, RawClose};
 
 }  // namespace
 
@@ -89,14 +100,12 @@ int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
   (void)one;
   struct timeval tv = {recv_timeout_ms / 1000, (recv_timeout_ms % 1000) * 1000};
   setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  struct ifreq ifr;
-  memset(&ifr, 0, sizeof ifr);
-  snprintf(ifr.ifr_name, IFNAMSIZ, "%s", self.interface.c_str());
-  if (ioctl(fd, SIOCGIFHWADDR, &ifr) == 0) memcpy(out->own_mac, ifr.ifr_hwaddr.sa_data, 6);
+  RawState* st = new RawState;
+  st->fd = fd;
+  st->ifindex = static_cast<int>(ifindex);
+  st->ethertype = net.ethertype;
   out->ops = &kRawOps;
-  out->fd = fd;
-  out->ifindex = static_cast<int>(ifindex);
-  out->ethertype = net.ethertype;
+  out->state = st;
   return 0;
 }
 

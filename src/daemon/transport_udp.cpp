@@ -8,25 +8,33 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "common/platform.h"
 #include "daemon/transport.h"
 
 namespace ccomm {
 namespace {
+
+struct UdpState {
+  int fd = -1;
+  uint16_t port = 0;  // network order
+};
+
+UdpState* State(Transport* t) { return static_cast<UdpState*>(t->state); }
 
 int UdpSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
   struct sockaddr_in sin;
   memset(&sin, 0, sizeof sin);
   sin.sin_family = AF_INET;
   sin.sin_addr.s_addr = to.ipv4;
-  sin.sin_port = to.port ? to.port : t->port;
-  ssize_t n = sendto(t->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
+  sin.sin_port = to.port ? to.port : State(t)->port;
+  ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
   return n == static_cast<ssize_t>(len) ? 0 : -errno;
 }
 
 ssize_t UdpRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
   struct sockaddr_in sin;
   socklen_t sl = sizeof sin;
-  ssize_t n = recvfrom(t->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sin), &sl);
+  ssize_t n = recvfrom(State(t)->fd, buf, cap, MSG_TRUNC, reinterpret_cast<struct sockaddr*>(&sin), &sl);
   if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -errno;
   if (static_cast<size_t>(n) > cap) return -EMSGSIZE;
   if (n == 0) return -ENODATA;  // an empty datagram; 0 means "timeout" to the caller
@@ -35,12 +43,15 @@ ssize_t UdpRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
   return n;
 }
 
+int UdpDrops(Transport* t, uint32_t* drops) { return platform::SocketDrops(State(t)->fd, drops); }
+
 void UdpClose(Transport* t) {
-  if (t->fd >= 0) close(t->fd);
-  t->fd = -1;
+  UdpState* st = State(t);
+  if (st->fd >= 0) close(st->fd);
+  delete st;
 }
 
-const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpClose};
+const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpClose};
 
 }  // namespace
 
@@ -100,9 +111,11 @@ int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
   }
   struct timeval tv = {recv_timeout_ms / 1000, (recv_timeout_ms % 1000) * 1000};
   setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  UdpState* st = new UdpState;
+  st->fd = fd;
+  st->port = htons(net.udp_port);
   out->ops = &kUdpOps;
-  out->fd = fd;
-  out->port = htons(net.udp_port);
+  out->state = st;
   return 0;
 }
 

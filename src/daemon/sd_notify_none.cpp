@@ -1,0 +1,14 @@
+// SPDX-License-Identifier: Apache-2.0
+// A build without libsystemd: no service manager to notify (see sd_notify.h).
+#include "daemon/sd_notify.h"
+
+namespace ccomm {
+namespace sd {
+
+void NotifyReady() {}
+void NotifyStopping() {}
+void NotifyWatchdog() {}
+uint64_t WatchdogIntervalNs() { return 0; }
+
+}  // namespace sd
+}  // namespace ccomm

@@ -102,6 +102,36 @@ echo "== 20-sim C-code target: step order and integration methods against 20-sim
 if python3 "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" \
      --ccomm-include "$here/../../src/include" --ccomm-lib "$(cd "$bin/../lib" && pwd)"; then :; else fail=1; fi
 
+echo "== 20-sim C-code target: the matrix model (StepOrder, Euler) as a task against ccommd"
+# u = K w with K = [1 0.5; -0.25 2], w = [w1; y[2]]: whatever w1 is at that sample,
+# u[2] = -0.25 (u[1] - 0.5 y[2]) + 2 y[2] must hold for every output the task writes.
+it_bg env LD_LIBRARY_PATH="$(cd "$bin/../lib" && pwd)" "$out/step_order/gen_Euler/task" --node ctrl --priority 0 \
+  >"$out/so.out" 2>"$out/so.err"
+so=$IT_PID
+it_bg "$bin/ccomm" --node ctrl pub r 1 --rate 200 --count 200
+it_bg "$bin/ccomm" --node ctrl pub y 0.2 0.5 --rate 200 --count 200
+so_ok=0
+for i in $(seq 40); do
+  sleep 0.05
+  got_u=$("$bin/ccomm" --node ctrl echo u --once 2>&1) || true
+  got_i=$("$bin/ccomm" --node ctrl echo integral --once 2>&1) || true
+  if python3 - "$got_u" "$got_i" <<'PY'
+import re, sys
+u = re.match(r"u \[([^,\]]+), ([^\]]+)\] fresh", sys.argv[1])
+i = re.match(r"integral (\S+) fresh", sys.argv[2])
+ok = bool(u and i) and float(i.group(1)) > 0.0
+if ok:
+    u1, u2 = float(u.group(1)), float(u.group(2))
+    ok = abs(u2 - (-0.25 * (u1 - 0.5 * 0.5) + 2.0 * 0.5)) <= 1e-4 * max(1.0, abs(u2))
+sys.exit(0 if ok else 1)
+PY
+  then so_ok=1; break; fi
+done
+if [ "$so_ok" = 1 ]; then echo "PASS matrix model task: $got_u; $got_i"
+else echo "FAIL matrix model task: u: $got_u; integral: $got_i"; cat "$out/so.err"; fail=1; fi
+it_stop "$so"
+[ "$IT_RC" = 0 ] || { echo "FAIL StepOrder task exit status $IT_RC: $(cat "$out/so.err")"; fail=1; }
+
 echo "== 20-sim C-code target: matrix helpers (xxmatrix.c as generated)"
 if ${CC:-cc} -std=c11 -Wall -Wextra -Wshadow -Werror -I"$out/step_order/gen_Euler" -o "$out/matrix_check" \
      "$here/test/matrix_check.c" "$out/step_order/gen_Euler/xxmatrix.c" -lm && "$out/matrix_check"; then :;

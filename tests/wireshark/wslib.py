@@ -69,7 +69,8 @@ class Tshark:
         self.home = tempfile.mkdtemp(prefix="home-", dir=workdir)
         os.chmod(self.home, 0o755)
         os.chmod(workdir, 0o755)
-        self.dissector = dissector
+        # a copy: the checkout may not be readable by the user tshark falls back to
+        self.dissector = self.readable(dissector)
         self.env = dict(os.environ, HOME=self.home, XDG_CONFIG_HOME=os.path.join(self.home, ".config"),
                         WIRESHARK_CONFIG_DIR=os.path.join(self.home, "wireshark"), TZ="UTC", LC_ALL="C.UTF-8")
         self.prefix = []
@@ -101,6 +102,12 @@ class Tshark:
         return r
 
     def readable(self, path):
+        """path, readable by every user (files from elsewhere are copied into HOME)."""
+        workdir = os.path.dirname(self.home)
+        if not os.path.abspath(path).startswith(workdir + os.sep):
+            copy = os.path.join(self.home, os.path.basename(path))
+            shutil.copyfile(path, copy)
+            path = copy
         os.chmod(path, 0o644)
         return path
 

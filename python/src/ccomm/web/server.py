@@ -15,7 +15,7 @@ import time
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Set, Tuple
+from typing import Any, Dict, List, Optional, Set, Tuple, cast
 
 import foxglove
 from foxglove.websocket import Capability, ServerListener
@@ -54,9 +54,10 @@ def find_assets(explicit: Optional[str] = None) -> Tuple[Optional[Path], List[Pa
     return None, tried
 
 
-class Subscriptions(ServerListener):
+class Subscriptions:
     """Who is subscribed to what, as the Foxglove server reports it (a client that
-    disconnects is unsubscribed from everything)."""
+    disconnects is unsubscribed from everything). A foxglove ServerListener: it has the
+    two methods it needs of that protocol (the others have defaults there)."""
 
     def __init__(self) -> None:
         self.lock = threading.Lock()
@@ -104,7 +105,7 @@ class LiveServer:
         self.channels = {i.name: foxglove.Channel(topic_of(i.name), schema=json_schema(i),
                                                   context=self.context) for i in self.infos}
         self.ws = foxglove.start_server(name="ccomm " + self.node_name, host=host, port=ws_port,
-                                        context=self.context, server_listener=self.subs,
+                                        context=self.context, server_listener=cast(ServerListener, self.subs),
                                         capabilities=[Capability.Time], message_backlog_size=1024)
         self.http = ThreadingHTTPServer((host, http_port), _handler(self))
         self.http.daemon_threads = True
@@ -117,7 +118,7 @@ class LiveServer:
 
     @property
     def ws_port(self) -> int:
-        return self.ws.port
+        return int(self.ws.port)
 
     @property
     def http_port(self) -> int:

@@ -34,7 +34,8 @@ part() {  # part NAME CMD...: runs one part, counts it
 
 build() {
   local core=(ccomm ccommd ccomm_cli)
-  local integ=(ccomm_20sim_pdcontroller ccomm_20sim_vectorgain ccomm_20sim_pd_check ccomm_20sim_4c_harness ccomm_simulink_harness)
+  local integ=(ccomm_20sim_pdcontroller ccomm_20sim_vectorgain ccomm_20sim_steporder ccomm_20sim_pd_check
+               ccomm_20sim_4c_harness ccomm_simulink_harness)
   if cmake --build "$B" --target help 2>/dev/null | grep -q ccomm_simulink_harness; then
     cmake --build "$B" -j "$jobs" --target "${core[@]}" "${integ[@]}" || return 1
     ibin=$B/bin

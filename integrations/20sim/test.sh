@@ -105,8 +105,7 @@ if python3 "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" 
 echo "== 20-sim C-code target: the matrix model (StepOrder, Euler) as a task against ccommd"
 # u = K w with K = [1 0.5; -0.25 2], w = [w1; y[2]]: whatever w1 is at that sample,
 # u[2] = -0.25 (u[1] - 0.5 y[2]) + 2 y[2] must hold for every output the task writes.
-it_bg env LD_LIBRARY_PATH="$(cd "$bin/../lib" && pwd)" "$out/step_order/gen_Euler/task" --node ctrl --priority 0 \
-  >"$out/so.out" 2>"$out/so.err"
+it_bg "$ibin/ccomm_20sim_steporder" --node ctrl --priority 0 >"$out/so.out" 2>"$out/so.err"
 so=$IT_PID
 it_bg "$bin/ccomm" --node ctrl pub r 1 --rate 200 --count 200
 it_bg "$bin/ccomm" --node ctrl pub y 0.2 0.5 --rate 200 --count 200

@@ -2,7 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Checks tokensubst.py's %IF% language on the conditions 20-sim's own templates use
 (EQ/NEQ on token values, nested NOT/OR/AND, numbers, tokens a target never defines) and
-that malformed conditions are refused with FILE:LINE. Exit 0 if every check passes."""
+that malformed conditions are refused with FILE:LINE; fuzzes the condition parser
+(CCOMM_FUZZ_SEED). Exit 0 if every check passes."""
+import os
+import random
 import sys
 from pathlib import Path
 
@@ -46,6 +49,24 @@ nested = ts.substitute("%IF%%NUMBER_STATES%\na\n%IF%%FMI1%\nb\n%ELSE%\nc\n%ENDIF
 if nested != "a\nc\n":
     print(f"FAIL nested %IF%/%ELSE%: {nested!r}")
     failures += 1
-print(f"{'PASS' if not failures else 'FAIL'} template language: {len(CASES) + len(BAD) + 1} checks, "
+# Fuzz the condition parser: random conditions and %IF%/%ELSE%/%ENDIF% soup must give
+# text or a TemplateError with FILE:LINE, never another exception.
+rnd = random.Random(int(os.environ.get("CCOMM_FUZZ_SEED", "1")))
+alphabet = ["EQ(", "NEQ(", "NOT(", "AND(", "OR(", "(", ")", ",", " ", "NUMBER_STATES", "FMI1", "2.0",
+            "%IF%%", "%ELSE%", "%ENDIF%", "%", "\n", "x", "-1", "INTEGRATION_METHOD_NAME"]
+for k in range(2000):
+    text = "%IF%%" + "".join(rnd.choice(alphabet) for _ in range(rnd.randint(1, 12))) + "%\nbody\n%ENDIF%\n"
+    try:
+        ts.substitute(text, TOKENS, "f.c", set())
+    except ts.TemplateError as e:
+        if not str(e).startswith("f.c"):
+            print(f"FAIL fuzz case {k}: error without FILE:LINE: {e}")
+            failures += 1
+    except Exception as e:  # noqa: BLE001 (the point of the fuzz run)
+        print(f"FAIL fuzz case {k}: {type(e).__name__}: {e} for {text!r}")
+        failures += 1
+        break
+
+print(f"{'PASS' if not failures else 'FAIL'} template language: {len(CASES) + len(BAD) + 1} checks and 2000 fuzzed conditions, "
       f"{failures} failed")
 sys.exit(1 if failures else 0)

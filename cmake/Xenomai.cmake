@@ -28,17 +28,43 @@ if(NOT _xeno_core STREQUAL "cobalt")
 endif()
 execute_process(COMMAND ${XENO_CONFIG} --skin=posix --cflags OUTPUT_VARIABLE _xeno_cflags
                 OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE _r2)
-# --auto-init: the Cobalt library initialises itself before main(), so ccommd and the
-# applications need no Xenomai-specific start-up code. The posix skin's flags include
-# the linker's --wrap list (cobalt.wrappers): open, read, sendto, pthread_*,
-# clock_gettime... resolve to Cobalt's versions in every target linked with them.
-execute_process(COMMAND ${XENO_CONFIG} --skin=posix --auto-init --ldflags OUTPUT_VARIABLE _xeno_ldflags
+# Auto-init: the Cobalt library initialises itself before main(), so ccommd and the
+# applications need no Xenomai-specific start-up code. Executables take --auto-init (a
+# main() wrapper), libccomm.so --auto-init-solib (a constructor: an application built
+# without xeno-config still gets Cobalt set up); xenomai_init() runs once either way.
+# The posix skin's flags include the linker's --wrap list (cobalt.wrappers): open, read,
+# sendto, pthread_*, clock_gettime... resolve to Cobalt's versions in every target
+# linked with them.
+execute_process(COMMAND ${XENO_CONFIG} --skin=posix --auto-init --ldflags OUTPUT_VARIABLE _xeno_exe
                 OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE _r3)
-if(NOT _r2 EQUAL 0 OR NOT _r3 EQUAL 0)
+execute_process(COMMAND ${XENO_CONFIG} --skin=posix --auto-init-solib --ldflags OUTPUT_VARIABLE _xeno_solib
+                OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE _r4)
+execute_process(COMMAND ${XENO_CONFIG} --libdir OUTPUT_VARIABLE XENOMAI_LIBDIR
+                OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE _r5)
+if(NOT _r2 EQUAL 0 OR NOT _r3 EQUAL 0 OR NOT _r4 EQUAL 0 OR NOT _r5 EQUAL 0)
   message(FATAL_ERROR "${XENO_CONFIG} --skin=posix failed; check the Xenomai installation")
 endif()
 separate_arguments(XENOMAI_CFLAGS UNIX_COMMAND "${_xeno_cflags}")
-separate_arguments(XENOMAI_LDFLAGS UNIX_COMMAND "${_xeno_ldflags}")
+separate_arguments(_xeno_exe UNIX_COMMAND "${_xeno_exe}")
+separate_arguments(_xeno_solib UNIX_COMMAND "${_xeno_solib}")
+# One list for ccomm_platform's users: flags both variants share as they are, the
+# others chosen by the type of the target being linked.
+set(_is_solib "$<STREQUAL:$<TARGET_PROPERTY:TYPE>,SHARED_LIBRARY>")
+set(XENOMAI_LDFLAGS)
+foreach(_f IN LISTS _xeno_exe)
+  if(_f IN_LIST _xeno_solib)
+    list(APPEND XENOMAI_LDFLAGS "${_f}")
+  else()
+    list(APPEND XENOMAI_LDFLAGS "$<$<NOT:${_is_solib}>:${_f}>")
+  endif()
+endforeach()
+foreach(_f IN LISTS _xeno_solib)
+  if(NOT _f IN_LIST _xeno_exe)
+    list(APPEND XENOMAI_LDFLAGS "$<${_is_solib}:${_f}>")
+  endif()
+endforeach()
+# Programs that link only libccomm.so find libcobalt through it.
+add_link_options("LINKER:-rpath-link,${XENOMAI_LIBDIR}")
 # Xenomai's headers are system headers to us: ccomm's -Werror is not for them.
 set(_xeno_flags)
 foreach(_f IN LISTS XENOMAI_CFLAGS)

@@ -199,6 +199,7 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
     }
   }
   TakeChanges(c);  // ccomm_wait() waits for writes after the open
+  ccomm::platform::ProcessId();  // fills the pid cache: the first write makes no syscall
   *out = c;
   return 0;
 }

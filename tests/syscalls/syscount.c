@@ -124,7 +124,10 @@ static void workload(const char* sleepy, const char* busy, long n) {
   for (i = 0; i < n; ++i) syscall(SYS_getppid);
   end();
 
-  must(ccomm_write_double(plain, fwd, 1.0), "write sleepy_state");
+  /* The first write of a process: no lazy set-up (pid cache...) may happen in it. */
+  begin("write:first-in-process,NO_DOORBELL", 1, 0, 0);
+  must(ccomm_write_double(quiet, fwd, 1.0), "first write");
+  end();
   sleep_ms(200); /* let ccommd go back to sleep */
   begin("read:own-state", n, 0, 0);
   for (i = 0; i < n; ++i) must(ccomm_read_double(plain, fwd, &v, &info), "read sleepy_state");
@@ -208,6 +211,7 @@ static const char* syscall_name(long nr) {
   switch (nr) {
     case SYS_futex: return "futex";
     case SYS_getppid: return "getppid";
+    case SYS_getpid: return "getpid";
     case SYS_clock_gettime: return "clock_gettime";
 #ifdef SYS_clock_gettime64
     case SYS_clock_gettime64: return "clock_gettime64";

@@ -277,7 +277,35 @@ static int trace(pid_t pid, struct phase* phases, int* nphases) {
   }
 }
 
+/* The table as Markdown (docs/performance.md embeds it), when $SYSCOUNT_MARKDOWN names
+ * a file. */
+static void report_markdown(const struct phase* phases, int n) {
+  const char* path = getenv("SYSCOUNT_MARKDOWN");
+  if (!path || !*path) return;
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    fprintf(stderr, "syscount: cannot write %s: %s\n", path, strerror(errno));
+    return;
+  }
+  fprintf(f, "| loop (mode, ccommd state) | calls | syscalls | per call | bound | which |\n"
+             "|:---|---:|---:|---:|---:|:---|\n");
+  for (int i = 0; i < n; ++i) {
+    const struct phase* p = &phases[i];
+    fprintf(f, "| %s | %ld | %ld | **%.4f** | %s%g | ", p->name, p->calls, p->total,
+            p->calls ? (double)p->total / (double)p->calls : 0.0, p->min_total ? "> 0, <= " : "", p->max_per_call);
+    for (long nr = 0; nr < MAX_NR; ++nr) {
+      if (!p->by_nr[nr]) continue;
+      const char* nm = syscall_name(nr);
+      if (nm) fprintf(f, "%s %ld ", nm, p->by_nr[nr]);
+      else fprintf(f, "#%ld %ld ", nr, p->by_nr[nr]);
+    }
+    fprintf(f, "|\n");
+  }
+  fclose(f);
+}
+
 static int report(const struct phase* phases, int n) {
+  report_markdown(phases, n);
   int failed = 0;
   printf("%-42s %8s %9s %9s %8s  %s\n", "phase", "calls", "syscalls", "per call", "bound", "result (syscalls by name)");
   for (int i = 0; i < n; ++i) {
@@ -312,7 +340,8 @@ int main(int argc, char** argv) {
             "each doorbell mode, against a running ccommd for each node: SLEEPY_NODE with\n"
             "spin_us 0 and signals sleepy_state (forwarded), sleepy_local, busy_state;\n"
             "BUSY_NODE with spin_us >= its heartbeat. CALLS per phase: default 20000.\n"
-            "Exit 0: every phase within its bound; 1: some phase above it; 2: set-up error.\n");
+            "Exit 0: every phase within its bound; 1: some phase above it; 2: set-up error.\n"
+            "SYSCOUNT_MARKDOWN=FILE also writes the table to FILE as Markdown.\n");
     return 2;
   }
   long n = argc == 4 ? strtol(argv[3], NULL, 10) : 20000;

@@ -8,8 +8,9 @@
 -- It checks every frame the way the receiver's DecodeHeader() does, in the same order,
 -- and raises one expert info per problem ("bad_entry: entry 0: unknown type 7"); the
 -- first one, which is what ccommd would count, is also the field ccomm.decode_error.
--- With the preference ccomm.config (a signals.xml) it names nodes and signals and flags
--- entries that do not match the configuration (receiver rule 6, bad_signal).
+-- With the preference ccomm.config (a signals.xml) it names nodes and signals, checks
+-- config_hash against the file's hash (receiver rule 4, config_mismatch) and flags entries
+-- that do not match the configuration (receiver rule 6, bad_signal).
 -- Documentation: docs/integrations/wireshark.md.
 
 local ccomm = Proto("ccomm", "ccomm signal frames")
@@ -21,8 +22,8 @@ local F_HEARTBEAT, F_AUTH, F_KNOWN = 0x01, 0x02, 0x03
 local E_EVENT, E_KNOWN = 0x01, 0x01
 local DEST_ALL = 0xFFFF
 
--- Lua 5.2 (Wireshark up to 4.2) has bit32; 5.3 and later have the operators instead (a
--- syntax error for 5.2's parser, hence load()).
+-- Builds with Lua 5.2 have bit32; with 5.3 or later, the operators instead (a syntax
+-- error for 5.2's parser, hence load()).
 local band = bit32 and bit32.band or load("return function(a, b) return a & b end")()
 local bxor = bit32 and bit32.bxor or load("return function(a, b) return a ~ b end")()
 

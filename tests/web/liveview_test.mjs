@@ -70,7 +70,7 @@ const canvasPixels = (page, signal) => page.evaluate((s) =>
   document.querySelector(`.chart[data-signal="${s}"] canvas`).toDataURL(), signal);
 
 const probe = new FoxgloveProbe(WS_URL);
-let browser, page, browser2;
+let browser, page, browser2, page2;
 const requests = [];
 const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "unused_sp", "mode_request"].map((s) => "/ccomm/" + s);
 
@@ -160,7 +160,7 @@ await check("a browser killed mid-stream: the server goes on, a second browser i
   process.kill(Number(pids[0]), "SIGKILL");
   await until(async () => (await stats()).clients === 1, 5000, "the killed browser's subscriptions dropped");
   browser2 = await chromium.launch(LAUNCH);
-  const page2 = await openPage(browser2, []);
+  page2 = await openPage(browser2, []);
   await until(() => page2.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "second page connected");
   const a = await until(async () => { const r = await domRow(page2, "tick"); return Number(r.value) > 0 && r; }, 5000, "tick on page 2");
   await sleep(600);
@@ -220,6 +220,25 @@ await check("the protocol client lost nothing while the browser died (every new 
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
   assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));
+});
+
+await check("ccommd stopped: every client is told (status message, page banner), and told when it is back", async () => {
+  const pid = Number(env("CCOMMD_PID"));
+  const banner = () => page2.evaluate(() => { const e = document.querySelector("#error"); return e.hidden ? "" : e.textContent; });
+  let statusMsg = null;
+  probe.client.on("status", (m) => { statusMsg = m; });
+  process.kill(pid, "SIGSTOP");  // no heartbeat: as if it had died, without losing the segment
+  try {
+    const text = await until(banner, 5000, "a banner on the page");
+    assert(text.includes("ccommd of node " + NODE + " is not running"), "banner: " + text);
+    await until(() => statusMsg, 2000, "a status message to the protocol client");
+    assert(statusMsg.level === 1 && statusMsg.id === "ccommd", JSON.stringify(statusMsg));
+    assert((await stats()).daemon_alive === false, "stats.json daemon_alive");
+  } finally {
+    process.kill(pid, "SIGCONT");
+  }
+  await until(async () => (await banner()) === "", 5000, "the banner gone");
+  assert((await stats()).daemon_alive === true, "stats.json daemon_alive again");
 });
 
 probe.close();

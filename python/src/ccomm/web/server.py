@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Set, Tuple, cast
 
 import foxglove
-from foxglove.websocket import Capability, ServerListener
+from foxglove.websocket import Capability, ServerListener, StatusLevel
 
 from ..client import CcommError, Client, RetiredError, SignalInfo
 from .sampler import Sampler, json_schema, topic_of
@@ -30,6 +30,7 @@ VENDOR_FILES = {
     "uPlot.iife.min.js": ("uplot/dist/uPlot.iife.min.js", "text/javascript"),
     "uPlot.min.css": ("uplot/dist/uPlot.min.css", "text/css"),
 }
+DAEMON_STATUS_ID = "ccommd"
 _STATIC_TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript", ".css": "text/css"}
 
 
@@ -113,6 +114,7 @@ class LiveServer:
         self.published: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.changes: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.sampler_error: Optional[str] = None
+        self.daemon_alive: Optional[bool] = None
         self._threads = [threading.Thread(target=self.http.serve_forever, name="http", daemon=True),
                          threading.Thread(target=self._sample_loop, name="sampler", daemon=True)]
 
@@ -153,6 +155,7 @@ class LiveServer:
                         started = time.monotonic()
                         client.wait(timeout=0.1)
                         sampler.poll()
+                        self._watch_daemon(client.daemon_alive)
                         for name, n in sampler.published.items():
                             self.published[name] = base[name] + n
                         for name, n in sampler.changes.items():
@@ -168,6 +171,21 @@ class LiveServer:
                 print("ccomm-web: %s; retrying in 1 s" % e, flush=True)
                 self.stop_event.wait(1.0)
 
+    def _watch_daemon(self, alive: bool) -> None:
+        """A stopped ccommd leaves its last values in memory, going stale: every client
+        is told why (a Foxglove status message, shown in its problems list and the page)."""
+        if alive == self.daemon_alive:
+            return
+        first, self.daemon_alive = self.daemon_alive is None, alive
+        if alive:
+            self.ws.remove_status([DAEMON_STATUS_ID])
+        else:
+            self.ws.publish_status("ccommd of node %s is not running (no heartbeat for 1 s): values are the "
+                                   "last it stored" % self.node_name, StatusLevel.Warning, DAEMON_STATUS_ID)
+        if not (first and alive):
+            print("ccomm-web: ccommd of node %s %s" % (self.node_name, "is running" if alive else "stopped"),
+                  flush=True)
+
     def config(self) -> Dict[str, Any]:
         return {"node": self.node_name, "ws_port": self.ws_port, "max_rate": self.max_rate,
                 "keepalive_s": self.keepalive, "plot": self.plot,
@@ -177,7 +195,7 @@ class LiveServer:
 
     def stats(self) -> Dict[str, Any]:
         s: Dict[str, Any] = {"published": dict(self.published), "changes": dict(self.changes),
-                             "sampler_error": self.sampler_error}
+                             "sampler_error": self.sampler_error, "daemon_alive": self.daemon_alive}
         s.update(self.subs.snapshot())
         return s
 

@@ -177,13 +177,14 @@ let ws = null, retryMs = 500;
 const channels = new Map();      // channel id -> signal name
 const subscriptions = new Map(); // subscription id -> signal name
 let nextSubId = 1;
+const statuses = new Map();      // the server's warnings by id (e.g. ccommd stopped)
 
 function connect() {
   const url = "ws://" + location.hostname + ":" + view.config.ws_port;
   setConn("connecting");
   ws = new WebSocket(url, SUBPROTOCOLS);
   ws.binaryType = "arraybuffer";
-  ws.onopen = () => { setConn("connected"); retryMs = 500; view.connections++; showError(""); };
+  ws.onopen = () => { setConn("connected"); retryMs = 500; view.connections++; statuses.clear(); showError(""); };
   ws.onclose = () => {
     setConn("disconnected");
     channels.clear();
@@ -212,7 +213,11 @@ function onText(text) {
   } else if (msg.op === "unadvertise") {
     for (const id of msg.channelIds) channels.delete(id);
   } else if (msg.op === "status" && msg.level >= 1) {
-    showError("server: " + msg.message);
+    statuses.set(msg.id || "", msg.message);
+    showError([...statuses.values()].join("; "));
+  } else if (msg.op === "removeStatus") {
+    for (const id of msg.statusIds) statuses.delete(id);
+    showError([...statuses.values()].join("; "));
   }
 }
 

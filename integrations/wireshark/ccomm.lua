@@ -447,7 +447,7 @@ local function dissect(tvb, pinfo, tree)
   ctx.hash_ok = config.hash ~= nil and tvb(8, 4):uint() == config.hash
   if config.hash and not ctx.hash_ok then
     hash_item:add_proto_expert_info(E.config_mismatch, string.format(
-      "config_mismatch: signals.xml (%s) hashes to %08x", config.path, config.hash))
+      "config_mismatch: the loaded signals.xml hashes to %08x", config.hash))
   end
 
   -- 5. the entries, within the declared payload (and what was captured)

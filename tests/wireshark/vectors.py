@@ -137,8 +137,8 @@ def check_malformed(pkt, name, expect, where, vocabulary):
         fail("%s: Lua error: %s" % (where, pkt["_ws.lua.text"]))
 
 
-def golden(ts, pcap, name, update):
-    out = ts.run(["-n", "-r", ts.readable(pcap), "-O", "ccomm"]).stdout
+def golden(ts, pcap, name, update, extra=()):
+    out = ts.run(["-n", "-r", ts.readable(pcap), "-O", "ccomm"] + list(extra)).stdout
     path = os.path.join(GOLDEN, name)
     if update:
         with open(path, "w") as f:
@@ -153,6 +153,26 @@ def golden(ts, pcap, name, update):
              % (name, diff))
     else:
         print("ok - tshark -O ccomm output equals golden/%s" % name)
+
+
+def config_frames():
+    """Frames to show the signals.xml support (golden vectors-config.txt, dist/signals.xml
+    loaded): a valid frame control -> planner; one whose entries break receiver rule 6
+    (a signal produced by the planner, a double sent as float, an unknown signal); a
+    heartbeat with another config_hash."""
+    e = wire_vectors.Entry
+    ok = wire_vectors.Frame("names", "ok", sender=0, dest=1, config_hash=DIST_HASH, seq=1, time_ns=10**9,
+                            entries=[e(0, "double", [0.5], seq=1, time_ns=10**9), e(35, "double", [-1.5], seq=1,
+                                                                                   time_ns=10**9)])
+    bad = wire_vectors.Frame("bad-signal", "ok", sender=0, dest=1, config_hash=DIST_HASH, seq=2, time_ns=2 * 10**9,
+                             entries=[e(36, "double", [1.0], seq=2), e(1, "float", [2.5], seq=2),
+                                      e(45, "double", [3.0], seq=2)])
+    other = wire_vectors.Frame("other-hash", "ok", sender=1, dest=0xFFFF, config_hash=DIST_HASH ^ 1, seq=3,
+                               time_ns=3 * 10**9, flags=wire_vectors.F_HEARTBEAT)
+    return [ok.data(), bad.data(), other.data()]
+
+
+DIST_HASH = 0xFB9A98FC  # ccommd --check dist/signals.xml (confighash.py checks the Lua side)
 
 
 def main():
@@ -201,6 +221,10 @@ def main():
         if len(failures) == before:
             print("ok - %s: %d valid vectors decode into the encoder's fields, %d malformed ones flagged "
                   "with their DecodeError" % (encap, valid, len(cases) - valid))
+    pcap = os.path.join(work, "vectors-config.pcap")
+    wslib.write_pcap(pcap, [wslib.udp(f) for f in config_frames()])
+    golden(ts, pcap, "vectors-config.txt", update,
+           ["-o", "ccomm.config:" + ts.readable(os.path.join(wslib.ROOT, "dist", "signals.xml"))])
     return 1 if failures else 0
 
 

@@ -75,7 +75,9 @@ void* Relay(void* arg) {
   for (;;) {
     ssize_t n = __STD(read)(d->relay_fd, &m, sizeof m);
     if (n < 0 && errno == EINTR) continue;
-    if (n != static_cast<ssize_t>(sizeof m) || m.kind == kQuit) break;
+    if (n <= 0) break;                                  // the real-time end is gone
+    if (n != static_cast<ssize_t>(sizeof m)) continue;  // not a message of ours: ignored
+    if (m.kind == kQuit) break;
     if (m.kind == kWait) {
       platform::FutexWait(&h->rx_doorbell, m.seen, m.timeout_ns);
       while (__STD(write)(d->relay_fd, &m.seq, sizeof m.seq) < 0 && errno == EINTR) {

@@ -9,13 +9,15 @@ veth pair this script sends the protocol.md vectors, random valid frames (every 
 arrays, events, tags) each also with one byte replaced, and junk.py's noise, truncations
 and mutations; first over UDP, then as raw Ethernet frames. The same bytes go through
 tshark with the dissector. The frames it finds valid are sent first: ccommd's frames_bad
-must not move; then the ones it flags: frames_bad must grow by exactly their number. So
+must not move; then the ones it flags: frames_bad must grow by exactly their number
+(less those the kernel dropped at ccommd's socket on a busy machine, at most 5 %). So
 both implementations draw the line between valid and malformed in the same place,
 frame by frame, Ethernet padding included.
 """
 import argparse
 import os
 import random
+import re
 import socket
 import struct
 import subprocess
@@ -43,15 +45,15 @@ def send_main(mode, target, path):
         s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         for i, fr in enumerate(frames):
             s.sendto(fr, (target, wslib.UDP_PORT))
-            if i % 50 == 49:
-                time.sleep(0.005)
+            if i % 25 == 24:
+                time.sleep(0.01)
     else:
         s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW)
         s.bind((target, 0))
         for i, fr in enumerate(frames):
             s.send(fr)
-            if i % 50 == 49:
-                time.sleep(0.005)
+            if i % 25 == 24:
+                time.sleep(0.01)
     return 0
 
 
@@ -89,6 +91,22 @@ def structured(rng, n):
 
 def frames_bad(pair):
     return pair.stats("planner")["counters"]["frames_bad"]
+
+
+def socket_drops(pair):
+    """Frames the kernel dropped at ccommd's sockets (receive buffer full: a busy machine),
+    from ss's skmem d<N>, like tests/reliability/lib.sh's sock_drops."""
+    pid = "pid=%d," % pair.daemons["planner"].pid
+    out = subprocess.run(pair.exec_prefix("planner") + ["ss", "-a", "-n", "-p", "-m", "-0", "-u"],
+                         capture_output=True, text=True).stdout
+    drops, want = 0, False
+    for line in out.splitlines():
+        if pid in line:
+            want = True
+        m = re.search(r",d(\d+)\)", line) if want and "skmem" in line else None
+        if m:
+            drops, want = drops + int(m.group(1)), False
+    return drops
 
 
 def settle(pair, timeout=10.0):
@@ -142,7 +160,7 @@ def main():
             payload = wire if transport == "raw" else junk
             groups = {"valid": [w for w, p in zip(payload, pkts) if "ccomm.decode_error" not in p],
                       "malformed": [w for w, p in zip(payload, pkts) if "ccomm.decode_error" in p]}
-            start = settle(pair)
+            start, dropped = settle(pair), socket_drops(pair)
             for name in ("valid", "malformed"):
                 path = os.path.join(args.workdir, "%s-%s.bin" % (transport, name))
                 with open(path, "wb") as f:
@@ -150,13 +168,15 @@ def main():
                         f.write(struct.pack(">H", len(w)) + w)
                 subprocess.run(["ip", "netns", "exec", ns, sys.executable, os.path.abspath(__file__), "--send",
                                 transport, "10.42.0.2" if transport == "udp" else "eth0", path], check=True)
-                now = settle(pair)
+                now, drops = settle(pair), socket_drops(pair)
+                lost = drops - dropped  # never reached ccommd: cannot count either way
                 want = len(groups[name]) if name == "malformed" else 0
-                ok = now - start == want
-                print("%s - %s: %d frames the dissector finds %s: ccommd's frames_bad grew by %d (expected %d)"
-                      % ("ok" if ok else "not ok", transport, len(groups[name]), name, now - start, want))
+                ok = want - lost <= now - start <= want and lost <= len(groups[name]) // 20
+                print("%s - %s: %d frames the dissector finds %s: ccommd's frames_bad grew by %d (expected %d%s)"
+                      % ("ok" if ok else "not ok", transport, len(groups[name]), name, now - start, want,
+                         ", %d dropped by the kernel before ccommd read them" % lost if lost else ""))
                 failed |= not ok
-                start = now
+                start, dropped = now, drops
     return 1 if failed else 0
 
 

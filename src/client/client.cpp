@@ -58,6 +58,8 @@ struct ccomm_client {
   uint8_t* cache_bytes = nullptr;  // the caches' values
   uint64_t cycle_ns = 0;           // ccomm_set_time(): "now" for reads and writes; 0 = clock
   bool pending_tx = false;         // CCOMM_OPEN_BATCH: forwarded writes since the last flush
+  uint64_t* pending_dirty = nullptr;  // CCOMM_OPEN_BATCH: their dirty bits, handed to ccommd at
+                                      // the flush only (signal_count bits)
   bool pending_rx = false;         // CCOMM_OPEN_BATCH: any write since the last flush
 };
 
@@ -172,7 +174,8 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   size_t cache_total = 0;
   for (uint32_t i = 0; i < n; ++i) cache_total += CachedBytes(c->segment.dir(i));
   c->cache_bytes = new (std::nothrow) uint8_t[cache_total ? cache_total : 1];
-  if (!c->sig || !c->cache_bytes) {
+  c->pending_dirty = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
+  if (!c->sig || !c->cache_bytes || !c->pending_dirty) {
     ccomm_close(c);
     return CCOMM_E_SYS;
   }
@@ -209,6 +212,7 @@ void ccomm_close(ccomm_client* c) {
   ccomm::client::DoorbellClose(c->doorbell);
   delete[] c->sig;
   delete[] c->cache_bytes;
+  delete[] c->pending_dirty;
   delete c;
 }
 
@@ -333,7 +337,9 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
   if ((h->flags & st::kSigForwarded) && !(h->flags & st::kSigPeriodic)) {
     const uint32_t id = static_cast<uint32_t>(s);
     if (c->flags & CCOMM_OPEN_BATCH) {
-      c->segment.MarkDirty(id);
+      // Not in the shared dirty map yet: a doorbell rung by another handle must not send
+      // part of this cycle. The flush hands them over at once.
+      c->pending_dirty[id / 64] |= 1ull << (id % 64);
       c->pending_tx = true;
     } else {
       ccomm::client::DoorbellNotifyTx(c->doorbell, id, ring);
@@ -390,6 +396,12 @@ int ccomm_flush(ccomm_client* c) {
   if (!c) return CCOMM_E_INVAL;
   const bool quiet = (c->flags & CCOMM_OPEN_NO_DOORBELL) != 0;  // no syscall, even here
   if (c->pending_tx) {
+    // Bounded: signal_count / 64 words (at most 64).
+    for (uint32_t w = 0; w < (c->signal_count + 63) / 64; ++w) {
+      if (!c->pending_dirty[w]) continue;
+      c->segment.MarkDirtyWord(w, c->pending_dirty[w]);
+      c->pending_dirty[w] = 0;
+    }
     if (quiet) c->segment.header()->tx_doorbell.fetch_add(1, std::memory_order_release);
     else ccomm::client::DoorbellRingTx(c->doorbell);
   }
@@ -485,7 +497,7 @@ int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name
       "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",
       "frames_unknown_sender", "frames_auth_failed", "frames_replayed", "frames_not_for_us",
       "entries_unknown_signal", "entries_wrong_type", "send_errors",  "tx_wakeups",
-      "recv_errors",       "slots_reclaimed",    "socket_drops"};
+      "recv_errors",       "slots_reclaimed",    "socket_drops",    "frames_wrong_source"};
   static_assert(sizeof(kNames) / sizeof(kNames[0]) == st::kDaemonCounterCount, "one name per DaemonCounter");
   if (!c || index < 0 || static_cast<uint32_t>(index) >= st::kDaemonCounterCount) return CCOMM_E_INVAL;
   if (name) *name = kNames[index];

@@ -261,6 +261,11 @@ class DaemonAuthTest : public ::testing::Test {
     cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
     cfg_.network.udp_port = FreeUdpPort();
     tx_ = socket(AF_INET, SOCK_DGRAM, 0);
+    // Frames claim node b: send them from b's configured address (receiver rule 2).
+    struct sockaddr_in src = {};
+    src.sin_family = AF_INET;
+    inet_pton(AF_INET, cfg_.nodes[1].ip.c_str(), &src.sin_addr);
+    EXPECT_EQ(bind(tx_, reinterpret_cast<const sockaddr*>(&src), sizeof src), 0);
     to_.sin_family = AF_INET;
     to_.sin_port = htons(cfg_.network.udp_port);
     to_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);

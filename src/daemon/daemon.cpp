@@ -4,6 +4,7 @@
 #include "daemon/daemon.h"
 #include "daemon/segment_builder.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <grp.h>
 #include <string.h>
@@ -32,7 +33,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   consumers_.assign(n, {});
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
-  last_rx_seq_.assign(n, 0);
+  rx_seq_.assign(n, SignalRx());
   last_tx_seq_.assign(n, 0);
   fresh_.assign(n, 0);
   TransportKind kind = opt.force_udp ? TransportKind::kUdp : self.transport;
@@ -68,6 +69,10 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       return -EINVAL;
     }
     pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
+    // UDP frames must come from the peer's own address (rule 2); raw frames carry no
+    // address worth checking (any station can send any source MAC).
+    if (kind == TransportKind::kUdp && !cfg.nodes[p].ip.empty())
+      inet_pton(AF_INET, cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
   }
 
   replay_.assign(m, auth::ReplayWindow());

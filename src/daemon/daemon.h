@@ -63,11 +63,26 @@ class Daemon {
     bool open = false;          // writer holds a begun frame
     uint8_t buf[wire::kMaxFrameSize];
   };
-  struct PeerRx {
+  // Receiver rule 5: one frame sequence per (sender, dest), dest = us or broadcast.
+  struct FrameStream {
     bool seen = false;
     uint32_t expected = 0;
+    uint32_t behind = 0;        // consecutive frames judged late/duplicate (resync rule)
     uint64_t last_send_ns = 0;  // newest send time seen: a lower seq sent later = restart
+  };
+  struct PeerRx {
+    FrameStream stream[2];      // [0]: frames addressed to us, [1]: broadcast
     uint64_t last_rx_ns = 0;    // our clock at its last accepted frame (receive thread only)
+    uint32_t ipv4 = 0;          // UDP: the configured source address (network order); 0 = any
+  };
+  // Receiver rule 6: a signal's last applied value. The wire carries 32-bit sequence
+  // numbers; `ext` extends them to 64 bits (serial arithmetic), so readers see a number
+  // that only grows, across wrap-around, producer restarts and resynchronisation.
+  struct SignalRx {
+    bool seen = false;
+    uint32_t wire = 0;          // last applied wire seq
+    uint32_t behind = 0;        // consecutive values judged not newer (resync rule)
+    uint64_t ext = 0;           // its 64-bit extension: the value_seq stored
   };
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
@@ -75,7 +90,11 @@ class Daemon {
                 const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
-  void HandleFrame(const uint8_t* buf, size_t len, uint64_t now);
+  void HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from);
+  /// Rule 5 for one accepted-so-far frame: false if it must be dropped as a duplicate.
+  void AccountFrame(const wire::FrameHeader& h, uint64_t now);
+  /// Rule 6: the value_seq to store for entry seq `seq` of signal `id`, or 0 to drop it.
+  uint64_t AcceptValue(uint32_t id, uint32_t seq, bool count_gaps);
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
   void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
@@ -100,7 +119,7 @@ class Daemon {
   std::vector<uint32_t> periodic_;                // forwarded periodic signal ids
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
-  std::vector<uint64_t> last_rx_seq_;             // signal -> last value_seq received
+  std::vector<SignalRx> rx_seq_;                  // signal -> last value received (rule 6)
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here

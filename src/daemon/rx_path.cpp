@@ -9,7 +9,83 @@
 
 namespace ccomm {
 
-void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
+namespace {
+
+// Resynchronisation (docs/protocol.md, rules 5 and 6): this many consecutive frames of a
+// stream (values of a signal) that all look older than what was accepted mean the stored
+// position is wrong (a forged or corrupted frame jumped it far ahead, or the sender's
+// numbering restarted in a way the other rules could not see), not that the network
+// reorders this much: the receiver follows the incoming stream again. Genuine duplicates
+// and reordering never produce this many in a row without an in-order one between.
+constexpr uint32_t kResyncAfter = 4;
+
+}  // namespace
+
+void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
+  store::PeerStats& ps = segment_.peer(h.sender);
+  PeerRx& pr = peers_rx_[h.sender];
+  FrameStream& fs = pr.stream[h.dest == wire::kDestAll ? 1 : 0];
+  const int32_t d = static_cast<int32_t>(h.seq - fs.expected);  // serial arithmetic
+  bool resync = false;
+  if (!fs.seen || d == 0) {
+    fs.seen = true;
+  } else if (d > 0) {
+    ps.frames_lost.fetch_add(static_cast<uint32_t>(d), std::memory_order_relaxed);
+  } else if (h.send_time_ns > fs.last_send_ns ||
+             (now - pr.last_rx_ns > peer_timeout_ns_ && h.send_time_ns <= now - pr.last_rx_ns)) {
+    // A lower seq sent later than anything seen: the peer's ccommd restarted. Or both went
+    // back after a silence longer than the sender's clock is old: the board rebooted in
+    // the meantime. (A frame that is merely late, even after a silence, was sent on an
+    // older clock than that: it must not roll the values back.)
+    resync = true;
+  } else if (++fs.behind >= kResyncAfter) {
+    resync = true;  // the stored position is wrong (see kResyncAfter)
+  } else {
+    ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
+    return;
+  }
+  if (resync) {
+    Log(LogLevel::kNotice, "peer '%s': frame sequence resynchronised (seq %u, expected %u)",
+        cfg_->nodes[h.sender].name.c_str(), h.seq, fs.expected);
+    // Its value sequence numbers may restart too: rule 6 follows them (readers keep a
+    // growing seq, see SignalRx).
+    for (size_t i = 0; i < rx_seq_.size(); ++i)
+      if (cfg_->signals[i].producer == h.sender) rx_seq_[i].seen = false;
+    fs.last_send_ns = h.send_time_ns;
+  }
+  fs.behind = 0;
+  fs.expected = h.seq + 1;
+  if (h.send_time_ns > fs.last_send_ns) fs.last_send_ns = h.send_time_ns;
+}
+
+uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
+  SignalRx& r = rx_seq_[id];
+  if (!r.seen) {  // first value, or after the producer restarted: numbering goes on
+    r.seen = true;
+    r.behind = 0;
+    r.ext = r.ext ? r.ext + 1 : seq;
+    r.wire = seq;
+    return r.ext ? r.ext : (r.ext = 1);
+  }
+  const int32_t d = static_cast<int32_t>(seq - r.wire);  // serial arithmetic
+  if (d > 0) {
+    if (d > 1 && count_gaps)
+      segment_.stats(id).lost.fetch_add(static_cast<uint32_t>(d) - 1, std::memory_order_relaxed);
+    r.ext += static_cast<uint32_t>(d);
+  } else if (d < 0 && ++r.behind >= kResyncAfter) {
+    r.ext += 1;  // resynchronise (kResyncAfter); nothing counted lost
+  } else {
+    // Older than what the signal has, or the same value again (a periodic signal's
+    // re-send, a duplicate): not new, and a re-send never counts towards resync, so an
+    // unchanged value still goes stale.
+    return 0;
+  }
+  r.behind = 0;
+  r.wire = seq;
+  return r.ext;
+}
+
+void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
   wire::FrameHeader h;
   if (wire::DecodeHeader(buf, len, &h) != wire::DecodeError::kOk) {
     Count(store::kFramesBad);
@@ -22,6 +98,10 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   }
   if (h.sender >= peers_rx_.size() || h.sender == self_ || !peers_tx_[h.sender].active) {
     Count(store::kFramesUnknownSender);
+    return;
+  }
+  if (peers_rx_[h.sender].ipv4 && from.ipv4 != peers_rx_[h.sender].ipv4) {
+    Count(store::kFramesWrongSource);  // claims a configured node, sent from elsewhere
     return;
   }
   if (h.dest != self_ && h.dest != wire::kDestAll) {
@@ -45,29 +125,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
   }
   store::PeerStats& ps = segment_.peer(h.sender);
   PeerRx& pr = peers_rx_[h.sender];
-  uint32_t ahead = h.seq - pr.expected;  // modulo 2^32
-  if (!pr.seen || ahead == 0) {
-    pr.seen = true;
-    pr.expected = h.seq + 1;
-  } else if (ahead < 0x80000000u) {
-    ps.frames_lost.fetch_add(ahead, std::memory_order_relaxed);
-    pr.expected = h.seq + 1;
-  } else if (h.send_time_ns > pr.last_send_ns ||
-             (now - pr.last_rx_ns > peer_timeout_ns_ && h.send_time_ns <= now - pr.last_rx_ns)) {
-    // A lower seq sent later than anything seen: the peer's ccommd restarted. Or both went
-    // back after a silence longer than the sender's clock is old: the board rebooted in
-    // the meantime. (A frame that is merely late, even after a silence, was sent on an
-    // older clock than that: it must not roll the values back.)
-    // Its value sequence numbers may restart too.
-    Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)",
-        cfg_->nodes[h.sender].name.c_str(), h.seq, pr.expected);
-    for (size_t i = 0; i < last_rx_seq_.size(); ++i)
-      if (cfg_->signals[i].producer == h.sender) last_rx_seq_[i] = 0;
-    pr.expected = h.seq + 1;
-  } else {
-    ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
-  }
-  if (h.send_time_ns > pr.last_send_ns) pr.last_send_ns = h.send_time_ns;
+  AccountFrame(h, now);
   pr.last_rx_ns = now;
   ps.frames_rx.fetch_add(1, std::memory_order_relaxed);
   ps.last_seq.store(h.seq, std::memory_order_relaxed);
@@ -97,17 +155,14 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now) {
       Count(store::kEntriesWrongType);
       continue;
     }
-    uint64_t& last = last_rx_seq_[e.signal];
-    if (last && e.seq <= last) continue;  // duplicate or older than what we have
-    store::SignalStats& ss = segment_.stats(e.signal);
     // Gaps mean lost values only where every value is sent (events, event-driven states).
-    if (last && e.seq > last + 1 && (is_event || sc.period_us == 0))
-      ss.lost.fetch_add(e.seq - last - 1, std::memory_order_relaxed);
-    last = e.seq;
+    const uint64_t value_seq = AcceptValue(e.signal, e.seq, is_event || sc.period_us == 0);
+    if (value_seq == 0) continue;  // duplicate or older than what we have
+    store::SignalStats& ss = segment_.stats(e.signal);
     wire::ValueToHost(e.type, e.value, rx_value_, e.count);
     store::StoreResult r =
-        is_event ? store::RingWrite(segment_.ring(e.signal), rx_value_, e.seq, e.source_time_ns, now)
-                 : store::StateWrite(segment_.state(e.signal), rx_value_, e.seq, e.source_time_ns, now);
+        is_event ? store::RingWrite(segment_.ring(e.signal), rx_value_, value_seq, e.source_time_ns, now)
+                 : store::StateWrite(segment_.state(e.signal), rx_value_, value_seq, e.source_time_ns, now);
     if (r != store::StoreResult::kOk) {
       ss.write_errors.fetch_add(1, std::memory_order_relaxed);
       continue;
@@ -133,7 +188,7 @@ void Daemon::RunRx() {
     PeerAddress from;
     ssize_t n = transport_.Recv(rx_buf_, sizeof rx_buf_, &from);
     if (n > 0) {
-      HandleFrame(rx_buf_, static_cast<size_t>(n), platform::MonotonicNs());
+      HandleFrame(rx_buf_, static_cast<size_t>(n), platform::MonotonicNs(), from);
     } else if (n < 0) {
       const bool bad_frame = n == -EMSGSIZE || n == -ENODATA;  // oversized or empty: junk, not a fault
       if (bad_frame) Count(store::kFramesBad);

@@ -72,6 +72,7 @@ enum DaemonCounter : uint32_t {
   kFramesAuthFailed, kFramesReplayed, kFramesNotForUs, kEntriesUnknownSignal,
   kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kSlotsReclaimed,
   kSocketDrops,  // frames the kernel dropped at ccommd's socket (receive buffer full)
+  kFramesWrongSource,  // UDP frames whose source address is not the sender's configured one
   kDaemonCounterCount
 };
 static_assert(kDaemonCounterCount <= 16, "daemon_counters has 16 entries");

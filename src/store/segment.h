@@ -68,6 +68,10 @@ class Segment {
   void MarkDirty(uint32_t id) const {
     dirty_words()[id / 64].fetch_or(1ull << (id % 64), std::memory_order_release);
   }
+  /// Marks the signals of dirty-map word `word` set in `bits` changed at once (a batch).
+  void MarkDirtyWord(uint32_t word, uint64_t bits) const {
+    dirty_words()[word].fetch_or(bits, std::memory_order_release);
+  }
   /// Wakes ccommd's send thread if it sleeps (one FUTEX_WAKE only then).
   void RingTxDoorbell() const;
   /// MarkDirty, then bumps the doorbell, waking ccommd if `wake` (see layout.h).

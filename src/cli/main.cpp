@@ -309,6 +309,13 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "list") && strcmp(cmd, "echo") && strcmp(cmd, "pub") && strcmp(cmd, "stats")) {
     return RunExternal(node, cmd, sub_argc, sub_argv);
   }
+  // `ccomm echo --help` prints help; it does not need (or try to reach) a daemon.
+  for (int i = 1; i < sub_argc; ++i) {
+    if (!strcmp(sub_argv[i], "-h") || !strcmp(sub_argv[i], "--help")) {
+      fputs(kUsage, stdout);
+      return 0;
+    }
+  }
   ccomm_client* c = nullptr;
   if (Open(node, &c) != 0) return 1;
   int r = 2;

@@ -3,6 +3,7 @@
 // in tx_path.cpp and rx_path.cpp).
 #include "daemon/daemon.h"
 #include "daemon/segment_builder.h"
+#include "daemon/sd_notify.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -25,6 +26,10 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   const NodeConfig& self = cfg.nodes[node_id];
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   heartbeat_ns_ = uint64_t{cfg.network.heartbeat_ms} * 1000000;
+  // main() pings the systemd watchdog only while the send loop advances: an idle loop
+  // must turn at least four times per watchdog interval.
+  const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
+  idle_sleep_ns_ = watchdog_ns && watchdog_ns / 4 < heartbeat_ns_ ? watchdog_ns / 4 : heartbeat_ns_;
   peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
 
   // Who do we talk to, and which signals go where.

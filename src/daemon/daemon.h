@@ -129,6 +129,7 @@ class Daemon {
   uint32_t socket_drops_seen_ = 0;  // the kernel's count for our socket at the last look
   bool wrong_hash_logged_ = false;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
+  uint64_t idle_sleep_ns_ = 0;  // longest sleep of an idle send loop
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_buf_[2048];

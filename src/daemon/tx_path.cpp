@@ -84,7 +84,6 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 
-constexpr uint64_t kMaxSleepNs = 100ull * 1000 * 1000;
 
 void Daemon::RunTx() {
   const NodeConfig& self = cfg_->nodes[self_];
@@ -109,8 +108,9 @@ void Daemon::RunTx() {
           CollectSignal(id, now, false);
       }
     }
-    // Wake at least every 100 ms even when idle: the watchdog needs this loop to advance.
-    uint64_t next_deadline = now + (heartbeat_ns_ < kMaxSleepNs ? heartbeat_ns_ : kMaxSleepNs);
+    // Idle, the loop wakes once per heartbeat (or more often if the service watchdog
+    // needs it to advance sooner, see idle_sleep_ns_).
+    uint64_t next_deadline = now + idle_sleep_ns_;
     for (uint32_t id : periodic_) {
       if (now >= due_ns_[id]) {
         CollectSignal(id, now, true);

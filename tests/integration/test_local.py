@@ -36,3 +36,31 @@ def test_two_apps_one_node(tmp_path):
         st = pair.stats("control")
         assert st["counters"]["frames_tx"] == 0 and st["counters"]["frames_rx"] == 0
     assert os.path.isdir(ROOT)
+
+
+def test_idle_send_thread_wakes_once_per_heartbeat(tmp_path):
+    """An idle ccommd's send thread sleeps a whole heartbeat_ms (docs/config.md), not a
+    shorter fixed tick: with heartbeat_ms=500 it wakes about twice a second."""
+    import time
+    cfg = tmp_path / "idle.xml"
+    cfg.write_text(LOCAL.replace('<ccomm version="1">',
+                                 '<ccomm version="1">\n  <network heartbeat_ms="500" peer_timeout_ms="1000"/>'))
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        before = pair.stats("control")["counters"]["tx_wakeups"]
+        t0 = time.time()
+        time.sleep(3.0)
+        wakeups = pair.stats("control")["counters"]["tx_wakeups"] - before
+        elapsed = time.time() - t0  # a stats call takes ~0.2 s
+        assert wakeups <= elapsed / 0.5 + 2, (wakeups, elapsed)
+        assert wakeups >= elapsed / 0.5 - 3, (wakeups, elapsed)  # and it does wake
+
+
+def test_subcommand_help_needs_no_daemon():
+    """`ccomm SUBCOMMAND --help` prints help (exit 0) even with no ccommd running."""
+    import subprocess
+    from harness import BIN
+    for sub in ("list", "echo", "pub", "stats"):
+        cp = subprocess.run([os.path.join(BIN, "ccomm"), "--node", "no-such-node", sub, "--help"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=10)
+        assert cp.returncode == 0 and cp.stdout.startswith("Usage: ccomm"), (sub, cp.returncode, cp.stderr)

@@ -44,9 +44,10 @@ typedef enum ccomm_status {
 } ccomm_status;
 
 /** Errors (< 0). ccomm_strerror() names them. */
-#define CCOMM_E_INVAL (-1)   /**< bad argument: NULL, unknown signal handle, wrong length */
+#define CCOMM_E_INVAL (-1)   /**< bad argument: NULL, unknown signal handle */
 #define CCOMM_E_NOENT (-2)   /**< no such signal, or no segment: is ccommd running? */
-#define CCOMM_E_TYPE (-3)    /**< typed call does not match the signal's type/count */
+#define CCOMM_E_TYPE (-3)    /**< typed call does not match the signal's type/count, or `len` is not
+                                   the signal's value_bytes */
 #define CCOMM_E_PERM (-4)    /**< this node is not the signal's producer */
 #define CCOMM_E_FULL (-5)    /**< event queue full: ccommd is not forwarding; event not queued */
 #define CCOMM_E_BUSY (-6)    /**< writers raced for every slot; retry next cycle */
@@ -115,14 +116,14 @@ CCOMM_API int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal
 CCOMM_API const char* ccomm_node_name(const ccomm_client* c);
 
 /**
- * Reads a signal. `len` must equal the signal's value_bytes. State signals: copies the
+ * Reads a signal. `len` must equal the signal's value_bytes (else CCOMM_E_TYPE). State signals: copies the
  * last value (or the safe value when stale, if configured). Event signals: pops the
  * next event for this handle, or returns CCOMM_EMPTY. Returns a ccomm_status (>= 0) or
  * an error (< 0); `info` may be NULL. Real-time safe.
  */
 CCOMM_API int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_info* info);
 /**
- * Writes a signal produced by this node; `len` must equal value_bytes. Returns 0 or an
+ * Writes a signal produced by this node; `len` must equal value_bytes (else CCOMM_E_TYPE). Returns 0 or an
  * error; nothing is half-written. Real-time safe (see the doorbell note above).
  */
 CCOMM_API int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len);

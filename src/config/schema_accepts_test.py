@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""docs/signals.xsd accepts every file ccommd accepts.
+
+  schema_accepts_test.py CCOMMD XSD FILE_OR_DIR...
+
+Each XML file given (directories: their *.xml and every file of fuzz corpora) that
+`ccommd --check` accepts must also validate under xmllint, and variants of each with its
+empty elements written with an end tag and whitespace between (<x ...>\\n  </x>) too.
+The parser stays the authority; the schema must never refuse what it accepts.
+Exit 0 if all hold, 1 with one line per file the schema refuses.
+"""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+
+def files(paths):
+    for p in paths:
+        if os.path.isdir(p):
+            for f in sorted(os.listdir(p)):
+                yield os.path.join(p, f)
+        else:
+            yield p
+
+
+def accepted(ccommd, path):
+    return subprocess.run([ccommd, "--check", path], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
+
+
+def validates(xsd, path):
+    cp = subprocess.run(["xmllint", "--noout", "--schema", xsd, path], stdout=subprocess.DEVNULL,
+                        stderr=subprocess.PIPE, text=True)
+    return cp.returncode == 0, cp.stderr.strip().splitlines()[:2]
+
+
+def main():
+    ccommd, xsd, paths = sys.argv[1], sys.argv[2], sys.argv[3:]
+    bad, checked = [], 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in files(paths):
+            if not os.path.isfile(path) or not accepted(ccommd, path):
+                continue
+            text = open(path, encoding="utf-8", errors="replace").read()
+            # The same file with every self-closing element opened and closed explicitly.
+            spread = re.sub(r"<(\w+)([^<>]*?)\s*/>", r"<\1\2>\n  </\1>", text)
+            variant = os.path.join(tmp, "spread.xml")
+            open(variant, "w", encoding="utf-8").write(spread)
+            for name, candidate in ((path, path), (path + " (end tags, whitespace)", variant)):
+                if candidate == variant and not accepted(ccommd, variant):
+                    continue
+                checked += 1
+                ok, why = validates(xsd, candidate)
+                if not ok:
+                    bad.append("%s: ccommd accepts it, the schema refuses it: %s" % (name, " / ".join(why)))
+    for b in bad:
+        print("schema: " + b)
+    print("schema: %d accepted files checked, %d refused by the schema" % (checked, len(bad)))
+    return 1 if bad or checked == 0 else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -142,6 +142,11 @@ const writer = spawn(env("PYTHON"), [env("WRITER"), NODE, String(WRITER_RATE), S
 let writerOut = "";
 writer.stdout.on("data", (d) => { writerOut += d; });
 const writerDone = new Promise((r) => writer.on("exit", (code) => r(code)));
+// A plain libccomm reader of the same values: the floor the latency is compared with.
+const floor = spawn(env("PYTHON"), [env("FLOOR_READER"), NODE, String(WRITER_COUNT), "60"], { stdio: ["ignore", "pipe", "inherit"] });
+let floorOut = "";
+floor.stdout.on("data", (d) => { floorOut += d; });
+const floorDone = new Promise((r) => floor.on("exit", (code) => r(code)));
 
 await check("arrays and events are plotted live; screenshot taken", async () => {
   await until(async () => (await domRow(page, "joint_pos")).chartPoints >= 20, 5000, "joint_pos points");
@@ -220,6 +225,10 @@ await check("the protocol client lost nothing while the browser died (every new 
   const lat = [...firsts.values()].map((m) => Number(m.mono - BigInt(m.msg.source_time_ns)) / 1e6).sort((a, b) => a - b);
   const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))].toFixed(2);
   console.log(`  # write -> protocol client latency (ms): min ${q(0)} p50 ${q(0.5)} p99 ${q(0.99)} max ${q(1)} (n=${lat.length})`);
+  assert((await floorDone) === 0, "floor reader failed: " + floorOut);
+  const f = JSON.parse(floorOut);
+  console.log(`  # floor, a libccomm reader of the same values (ms): p50 ${f.p50_ms} p99 ${f.p99_ms} (n=${f.n}); ` +
+              `ccomm-web p50 / floor p50 = ${(Number(q(0.5)) / f.p50_ms).toFixed(1)}`);
   const events = probe.received("/ccomm/mode_request").map((m) => m.msg.value);
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));

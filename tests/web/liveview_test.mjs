@@ -48,11 +48,11 @@ const LAUNCH = {
          "--disable-component-update", "--disable-sync"],
 };
 
-async function openPage(browser, requests) {
+async function openPage(browser, requests, query = "") {
   const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
   page.on("request", (r) => requests.push(r.url()));
   page.on("pageerror", (e) => console.log("  # page error: " + e));
-  const resp = await page.goto(WEB_URL, { waitUntil: "load" });
+  const resp = await page.goto(WEB_URL + query, { waitUntil: "load" });
   assert(resp.ok(), "GET / answered " + resp.status());
   return page;
 }
@@ -104,10 +104,16 @@ await check("page loads in headless Chromium, from the server only (no other ori
   assert(foreign.length === 0, "requests elsewhere: " + foreign.join(" "));
 });
 
-await check("page connects over the Foxglove protocol and lists every signal", async () => {
+await check("page connects over the Foxglove protocol, lists every signal, plots the ticked ones", async () => {
   await until(() => page.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "#conn connected");
   const rows = await page.evaluate(() => [...document.querySelectorAll("#signals tbody tr")].map((tr) => tr.dataset.signal));
   assert(rows.length === 6, "rows: " + rows);
+  const charts = () => page.evaluate(() => [...document.querySelectorAll(".chart")].map((c) => c.dataset.signal).join(","));
+  assert((await charts()) === rows.join(","), "charts at first (--plot default: all 6): " + (await charts()));
+  await page.click('#signals tr[data-signal="tick"] input');  // untick: its plot goes
+  assert(!(await charts()).split(",").includes("tick"), "tick still plotted: " + (await charts()));
+  await page.click('#signals tr[data-signal="tick"] input');
+  assert((await charts()).split(",").includes("tick"), "tick not plotted again: " + (await charts()));
   await until(async () => (await domRow(page, "unused_sp")).status === "never", 3000, "unused_sp never");
 });
 
@@ -167,12 +173,14 @@ await check("a browser killed mid-stream: the server goes on, a second browser i
   process.kill(Number(pids[0]), "SIGKILL");
   await until(async () => (await stats()).clients === 1, 5000, "the killed browser's subscriptions dropped");
   browser2 = await chromium.launch(LAUNCH);
-  page2 = await openPage(browser2, []);
+  page2 = await openPage(browser2, [], "?plot=tick,joint_pos");
   await until(() => page2.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "second page connected");
   const a = await until(async () => { const r = await domRow(page2, "tick"); return Number(r.value) > 0 && r; }, 5000, "tick on page 2");
   await sleep(600);
   const b = await domRow(page2, "tick");
   assert(Number(b.value) > Number(a.value) && b.plotted > a.plotted, `tick did not advance on page 2: ${a.value} -> ${b.value}`);
+  const charts = await page2.evaluate(() => [...document.querySelectorAll(".chart")].map((c) => c.dataset.signal).join(","));
+  assert(charts === "tick,joint_pos", "?plot=tick,joint_pos gave charts " + charts);
 });
 
 await check("bad protocol input from a client: refused, server still serves", async () => {

@@ -44,17 +44,17 @@ def parse_args(argv: Optional[List[str]]) -> argparse.Namespace:
     p = argparse.ArgumentParser(prog="ccomm-web", description=DESCRIPTION, epilog=EPILOG,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("signals", nargs="*", metavar="SIGNAL", help="signals to serve (default: all)")
-    p.add_argument("-n", "--node", help="node to attach to (default: $CCOMM_NODE, else hostname)")
-    p.add_argument("--host", default="127.0.0.1",
+    p.add_argument("-n", "--node", metavar="NAME", help="node to attach to (default: $CCOMM_NODE, else hostname)")
+    p.add_argument("--host", default="127.0.0.1", metavar="ADDR",
                    help="address to listen on (default 127.0.0.1; 0.0.0.0 for other machines)")
-    p.add_argument("--port", type=int, default=8765, help="Foxglove WebSocket port (default 8765; 0: any)")
-    p.add_argument("--http-port", type=int, default=8080, help="page port (default 8080; 0: any)")
-    p.add_argument("--plot", help="comma-separated signals the page plots at first "
+    p.add_argument("--port", type=int, default=8765, metavar="N", help="Foxglove WebSocket port (default 8765; 0: any)")
+    p.add_argument("--http-port", type=int, default=8080, metavar="N", help="page port (default 8080; 0: any)")
+    p.add_argument("--plot", metavar="A,B,...", help="comma-separated signals the page plots at first "
                    "(default: the first 8 served; the page can change it)")
-    p.add_argument("--max-rate", type=float, default=100.0, help="samples per second at most (default 100)")
-    p.add_argument("--keepalive", type=float, default=1.0,
+    p.add_argument("--max-rate", type=float, default=100.0, metavar="HZ", help="samples per second at most (default 100)")
+    p.add_argument("--keepalive", type=float, default=1.0, metavar="S",
                    help="republish an unchanged signal after this many seconds (default 1)")
-    p.add_argument("--assets", help="directory with node_modules/uplot (default: see below)")
+    p.add_argument("--assets", metavar="DIR", help="directory with node_modules/uplot (default: see below)")
     a = p.parse_args(argv)
     if not 0 < a.max_rate <= 10000:
         p.error("--max-rate must be in (0, 10000]")

@@ -1,0 +1,135 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The content of a ccomm recording (see docs/integrations/record.md).
+
+One MCAP channel per signal, topic = the signal's name, message encoding "json", schema
+encoding "jsonschema": tools that know MCAP plot the fields without ccomm. A message:
+
+    {"value": 1.5, "seq": 812, "source_time_ns": ..., "receive_time_ns": ...,
+     "status": "fresh", "fresh": true, "safe_value": false,
+     "lost": 0, "gap": 0}
+
+value           a number (bool: true/false), or an array for count > 1; NaN and
+                infinities are JSON null (JSON has no such numbers)
+seq             the producer's sequence number of the value (1, 2, 3 ... per write)
+source_time_ns  the producer's CLOCK_MONOTONIC when it wrote the value
+receive_time_ns the recording node's CLOCK_MONOTONIC when the value reached it
+status / fresh  ccomm's freshness of the value when read (fresh, stale)
+lost            values of the signal ccomm knows were lost before this one (the
+                counter of ccomm_info: network gaps and overruns; cumulative)
+gap             values the recorder did not see between the previous message and this one
+                (a jump in seq); 0 in a complete recording
+
+The MCAP log time is the receive time and the publish time the source time, both moved
+to the Unix epoch by the offset between CLOCK_REALTIME and CLOCK_MONOTONIC at the start
+of the recording (in the "ccomm" metadata record); the publish time is exact only when
+the producer shares the recorder's clock (one host).
+"""
+from __future__ import annotations
+
+import json
+import struct
+from typing import Callable, Dict, Tuple
+
+from .capi import STATUS_NAMES, TYPE_FORMATS, SignalDesc
+
+SCHEMA_ENCODING = "jsonschema"
+MESSAGE_ENCODING = "json"
+SCHEMA_PREFIX = "ccomm."
+METADATA_NAME = "ccomm"
+FORMAT_VERSION = "1"
+
+# A captured value as the recorder hands it to the writer: signal id, status, flags, seq,
+# receive time, source time, lost; then value_bytes bytes of value.
+RECORD = struct.Struct("<HBBQqQQ")
+FLAG_SAFE_VALUE = 0x1
+
+_JSON_TYPES = {"bool": "boolean", "int32": "integer", "uint32": "integer", "int64": "integer",
+               "float": "number", "double": "number"}
+
+
+def schema_name(desc: SignalDesc) -> str:
+    return SCHEMA_PREFIX + desc.type_text
+
+
+def json_schema(desc: SignalDesc) -> bytes:
+    """JSON Schema of one signal's messages (one schema per type and count)."""
+    elem = {"type": [_JSON_TYPES[desc.type], "null"]}
+    value = elem if desc.count == 1 else {"type": "array", "items": elem,
+                                          "minItems": desc.count, "maxItems": desc.count}
+    integer = {"type": "integer"}
+    schema = {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": schema_name(desc),
+        "description": f"a ccomm {desc.type_text} signal value and what ccomm knows about it",
+        "type": "object",
+        "properties": {
+            "value": value,
+            "seq": dict(integer, description="producer's sequence number of the value"),
+            "source_time_ns": dict(integer, description="producer's CLOCK_MONOTONIC at the write"),
+            "receive_time_ns": dict(integer, description="recording node's CLOCK_MONOTONIC at arrival"),
+            "status": {"type": "string", "enum": ["fresh", "stale"]},
+            "fresh": {"type": "boolean"},
+            "safe_value": {"type": "boolean", "description": "value is the configured safe value"},
+            "lost": dict(integer, description="values known lost before this one (cumulative)"),
+            "gap": dict(integer, description="values the recorder missed just before this one"),
+        },
+        "required": ["value", "seq", "source_time_ns", "receive_time_ns", "status", "lost", "gap"],
+    }
+    return json.dumps(schema, indent=1).encode()
+
+
+def channel_metadata(desc: SignalDesc) -> Dict[str, str]:
+    """What replay checks against the node it writes to."""
+    return {"ccomm.signal": desc.name, "ccomm.type": desc.type, "ccomm.count": str(desc.count),
+            "ccomm.event": "1" if desc.is_event else "0", "ccomm.producer": desc.producer,
+            "ccomm.format": FORMAT_VERSION}
+
+
+def value_struct(type_name: str, count: int) -> struct.Struct:
+    return struct.Struct("<%d%s" % (count, TYPE_FORMATS[type_name]))
+
+
+def _number_text(type_name: str) -> Callable[[object], str]:
+    if type_name == "bool":
+        return lambda v: "true" if v else "false"
+    if type_name in ("float", "double"):
+        # repr is the shortest text that reads back as the same double (and a float32
+        # widened to double reads back as the same float32); it has an 'n' only for
+        # nan/inf, which JSON cannot carry.
+        return lambda v: "null" if "n" in repr(v) else repr(v)
+    return str
+
+
+# encode(buffer, offset of the value, status, flags, seq, recv_ns, src_ns, lost, gap)
+MessageEncoder = Callable[[bytes, int, int, int, int, int, int, int, int], bytes]
+
+
+def message_encoder(desc: SignalDesc) -> Tuple[struct.Struct, MessageEncoder]:
+    """(value struct, MessageEncoder) for one signal: the JSON message as bytes, built
+    with one format operation (the writer encodes up to 100 000 of them a second)."""
+    vs = value_struct(desc.type, desc.count)
+    number = _number_text(desc.type)
+    floating = desc.type in ("float", "double")
+    head = '{"value":'
+    tail = ('"seq":%d,"source_time_ns":%d,"receive_time_ns":%d,"status":"%s",'
+            '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d}')
+    unpack_from = vs.unpack_from
+    scalar = desc.count == 1
+
+    def encode(buf: bytes, off: int, status: int, flags: int, seq: int, recv: int, src: int, lost: int,
+               gap: int) -> bytes:
+        vals = unpack_from(buf, off)
+        if scalar:
+            text = number(vals[0])
+        elif floating:
+            text = "[" + ",".join(map(repr, vals)) + "]"
+            if "n" in text:  # nan/inf somewhere: slow path, element by element
+                text = "[" + ",".join(map(number, vals)) + "]"
+        else:
+            text = "[" + ",".join(map(number, vals)) + "]"
+        return (head + text + "," + tail % (
+            seq, src, recv, STATUS_NAMES[status] if status < 4 else "?",
+            "true" if status == 0 else "false", "true" if flags & FLAG_SAFE_VALUE else "false",
+            lost, gap)).encode()
+
+    return vs, encode

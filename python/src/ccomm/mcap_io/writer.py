@@ -1,0 +1,241 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The recorder's writer process: captured records in (a pipe), MCAP files out.
+
+It runs apart from the capture loop so that encoding and disk writes never delay a read
+(a state signal read late may already hold the next value). It ends when the pipe
+closes: after the capture loop's clean stop, and also when the capture process was
+killed (kill -9), so the file is complete in both cases. Killed itself, it leaves a file
+that holds every chunk written so far (a chunk is closed at least once a second);
+`ccomm-record --recover` makes a complete file of it.
+"""
+from __future__ import annotations
+
+import json
+import os
+import select
+import signal
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import IO, Dict, List, Optional
+
+from mcap.writer import CompressionType, Writer
+
+from .capi import SignalDesc
+from .schema import (FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
+                     channel_metadata, json_schema, message_encoder, schema_name)
+
+COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
+               "zstd": CompressionType.ZSTD}
+
+
+@dataclass
+class WriterOptions:
+    output: str
+    signals: List[SignalDesc]
+    node: str
+    compression: str = "lz4"
+    chunk_size: int = 1 << 20
+    rotate_bytes: int = 0  #: 0: no rotation by size
+    rotate_seconds: float = 0  #: 0: no rotation by time
+    clock_offset_ns: int = 0  #: CLOCK_REALTIME - CLOCK_MONOTONIC at the start
+    progress: str = "auto"  #: auto (a line in place on a terminal), lines, none
+    stats_json: Optional[str] = None
+    started_ns: int = 0
+
+
+@dataclass
+class SignalStats:
+    values: int = 0
+    first_seq: int = 0
+    last_seq: int = 0
+    gaps: int = 0  #: values missed by the recorder (jumps in seq that ccomm did not count lost)
+    first_lost: int = -1
+    last_lost: int = 0
+
+
+@dataclass
+class FileSet:
+    """The files written so far (several with rotation)."""
+    paths: List[str] = field(default_factory=list)
+    bytes_done: int = 0  #: sizes of the closed files
+
+
+def rotated_name(output: str, index: int) -> str:
+    stem, ext = os.path.splitext(output)
+    return f"{stem}-{index:04d}{ext or '.mcap'}"
+
+
+class RecordingWriter:
+    def __init__(self, o: WriterOptions) -> None:
+        self.o = o
+        self.by_id: Dict[int, SignalDesc] = {d.id: d for d in o.signals}
+        self.encoders = {d.id: message_encoder(d)[1] for d in o.signals}
+        self.value_bytes = {d.id: d.value_bytes for d in o.signals}
+        self.stats = {d.id: SignalStats() for d in o.signals}
+        self.files = FileSet()
+        self.values = 0
+        self.stream: Optional[IO[bytes]] = None
+        self.mcap: Optional[Writer] = None
+        self.channel: Dict[int, int] = {}
+        self.file_opened = 0.0
+        self.rotating = o.rotate_bytes > 0 or o.rotate_seconds > 0
+
+    # ---- files ---------------------------------------------------------------------
+    def _open(self) -> None:
+        path = rotated_name(self.o.output, len(self.files.paths)) if self.rotating else self.o.output
+        self.stream = open(path, "wb")
+        self.files.paths.append(path)
+        w = Writer(self.stream, chunk_size=self.o.chunk_size, compression=COMPRESSION[self.o.compression])
+        w.start(profile="", library="ccomm-record")
+        schemas: Dict[str, int] = {}
+        self.channel = {}
+        for d in self.o.signals:
+            name = schema_name(d)
+            if name not in schemas:
+                schemas[name] = w.register_schema(name, SCHEMA_ENCODING, json_schema(d))
+            self.channel[d.id] = w.register_channel(d.name, MESSAGE_ENCODING, schemas[name],
+                                                    channel_metadata(d))
+        w.add_metadata(METADATA_NAME, {
+            "format": FORMAT_VERSION, "node": self.o.node,
+            "clock_offset_ns": str(self.o.clock_offset_ns),
+            "started_realtime_ns": str(self.o.started_ns),
+            "file_index": str(len(self.files.paths) - 1),
+            "signals": ",".join(d.name for d in self.o.signals)})
+        self.mcap = w
+        self.file_opened = time.monotonic()
+
+    def _close(self) -> None:
+        if self.mcap is not None and self.stream is not None:
+            self.mcap.finish()
+            self.stream.close()
+            self.files.bytes_done += os.path.getsize(self.files.paths[-1])
+        self.mcap = None
+        self.stream = None
+
+    def _size(self) -> int:
+        return self.stream.tell() if self.stream is not None else 0
+
+    def maybe_rotate(self) -> None:
+        if not self.rotating or self.mcap is None:
+            return
+        if (self.o.rotate_bytes and self._size() >= self.o.rotate_bytes) or \
+           (self.o.rotate_seconds and time.monotonic() - self.file_opened >= self.o.rotate_seconds):
+            self._close()
+            self._open()
+
+    def total_bytes(self) -> int:
+        return self.files.bytes_done + self._size()
+
+    # ---- records -------------------------------------------------------------------
+    def add(self, buf: bytearray) -> int:
+        """Writes the complete records at the start of `buf`; returns the bytes used."""
+        assert self.mcap is not None
+        add_message, channel, encoders = self.mcap.add_message, self.channel, self.encoders
+        vbytes, stats, offset = self.value_bytes, self.stats, self.o.clock_offset_ns
+        unpack_from, head = RECORD.unpack_from, RECORD.size
+        pos, end, n = 0, len(buf), 0
+        while pos + head <= end:
+            sid, status, flags, seq, recv, src, lost = unpack_from(buf, pos)
+            size = vbytes[sid]
+            if pos + head + size > end:
+                break
+            st = stats[sid]
+            gap = seq - st.last_seq - 1 if st.values and seq > st.last_seq else 0
+            if st.values == 0:
+                st.first_seq, st.first_lost = seq, lost
+            elif gap:
+                # ccomm counted lost values itself (a network gap): those the recorder could
+                # not have seen; the rest of the jump it missed (read too late)
+                st.gaps += max(0, gap - (lost - st.last_lost))
+            st.values += 1
+            st.last_seq, st.last_lost = seq, lost
+            data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap)
+            add_message(channel[sid], recv + offset, data, src + offset, seq & 0xFFFFFFFF)
+            pos += head + size
+            n += 1
+        self.values += n
+        return pos
+
+    def flush(self) -> None:
+        if self.mcap is not None:
+            self.mcap.flush()  # closes the chunk: what a kill -9 of this process keeps
+
+    def lost_total(self) -> int:
+        return sum(s.gaps for s in self.stats.values())
+
+    def ccomm_lost_total(self) -> int:
+        return sum(s.last_lost - s.first_lost for s in self.stats.values() if s.values)
+
+    def summary(self, seconds: float) -> dict:
+        return {
+            "node": self.o.node, "files": self.files.paths, "seconds": round(seconds, 3),
+            "values": self.values, "bytes": self.total_bytes(),
+            "values_per_s": round(self.values / seconds, 1) if seconds > 0 else 0.0,
+            "recorder_missed": self.lost_total(), "ccomm_lost": self.ccomm_lost_total(),
+            "signals": {self.by_id[i].name: {"values": s.values, "first_seq": s.first_seq,
+                                             "last_seq": s.last_seq, "missed": s.gaps,
+                                             "lost": (s.last_lost - s.first_lost) if s.values else 0}
+                        for i, s in self.stats.items()},
+        }
+
+
+def _progress_line(w: RecordingWriter, elapsed: float, rate: float) -> str:
+    return (f"record: {elapsed:7.1f} s  {w.values:10d} values  {rate:9.0f} values/s  "
+            f"{w.total_bytes() / 1e6:8.2f} MB  missed {w.lost_total()}  lost {w.ccomm_lost_total()}")
+
+
+def run_writer(fd: int, o: WriterOptions) -> int:
+    """The writer process's main: returns its exit status."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the terminal's ^C is the capture's to handle
+    stop = []
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    w = RecordingWriter(o)
+    try:
+        w._open()
+    except OSError as e:
+        print(f"record: cannot write {e.filename}: {e.strerror}", file=sys.stderr)
+        return 1
+    mode = o.progress
+    if mode == "auto":
+        mode = "tty" if sys.stderr.isatty() else "lines"
+    every = 1.0 if mode == "tty" else 5.0
+    buf = bytearray()
+    t0 = last_flush = last_report = time.monotonic()
+    reported_values = 0
+    while not stop:
+        ready, _, _ = select.select([fd], [], [], 0.2)
+        if ready:
+            data = os.read(fd, 1 << 20)
+            if not data:
+                break
+            buf += data
+            used = w.add(buf)
+            del buf[:used]
+            w.maybe_rotate()
+        now = time.monotonic()
+        if now - last_flush >= 1.0:
+            w.flush()
+            last_flush = now
+        if mode != "none" and now - last_report >= every:
+            rate = (w.values - reported_values) / (now - last_report)
+            line = _progress_line(w, now - t0, rate)
+            print("\r" + line if mode == "tty" else line, end="" if mode == "tty" else "\n",
+                  file=sys.stderr, flush=True)
+            last_report, reported_values = now, w.values
+    if buf:
+        print(f"record: {len(buf)} bytes of an incomplete record at the end dropped "
+              "(the capture process died mid-write)", file=sys.stderr)
+    w._close()
+    elapsed = time.monotonic() - t0
+    s = w.summary(elapsed)
+    if mode == "tty":
+        print(file=sys.stderr)
+    if mode != "none":
+        print(f"record: {', '.join(s['files'])}: {s['values']} values of {len(o.signals)} signals in "
+              f"{elapsed:.1f} s ({s['values_per_s']:.0f}/s), {s['bytes'] / 1e6:.2f} MB, missed by the "
+              f"recorder {s['recorder_missed']}, lost in ccomm {s['ccomm_lost']}", file=sys.stderr)
+    if o.stats_json:
+        with open(o.stats_json, "w") as f:
+            json.dump(s, f, indent=1)
+    return 0

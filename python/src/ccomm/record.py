@@ -1,0 +1,318 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ccomm-record: records this node's signals into an MCAP file.
+
+Two processes: this one waits for changes (ccomm_wait) and reads every selected signal
+with preallocated buffers, passing each new value (a new seq) as a fixed binary record to
+a writer process through a pipe; the writer (mcap_io.writer) encodes the messages and
+writes the file. So the loop that must keep up with the signals does nothing else.
+"""
+from __future__ import annotations
+
+import argparse
+import ctypes
+import fnmatch
+import gc
+import json
+import os
+import resource
+import signal
+import struct
+import sys
+import time
+from typing import Callable, List, Optional, Sequence
+
+from .mcap_io import require_mcap
+from .mcap_io.capi import INFO_FORMAT, CcommCallError, Handle, SignalDesc
+from .mcap_io.schema import RECORD
+
+EXAMPLES = """\
+examples:
+  ccomm-record -o run.mcap                       every signal this node holds, until ^C
+  ccomm record --node planner -o run.mcap -d 10  the same through the ccomm CLI, 10 s
+  ccomm-record -s 'wheel*,arm0_pos' -o wheels.mcap
+  ccomm-record --rotate-size 100 -o long.mcap    long-0000.mcap, long-0001.mcap, ... of 100 MB
+  ccomm-record --recover cut.mcap -o fixed.mcap  a complete file from a truncated one
+
+Open the file in Foxglove or PlotJuggler, or read it with the `mcap` Python package:
+one channel per signal (topic = signal name), JSON messages with value, seq,
+source_time_ns, receive_time_ns, status, lost and gap. See docs/integrations/record.md.
+Exit status: 0 done, 1 runtime error, 2 bad arguments or selection.
+"""
+
+
+def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(
+        prog="ccomm-record", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Record the values of a ccomm node's signals (every value, with its seq, "
+                    "source and receive time, freshness and loss) into an MCAP file.",
+        epilog=EXAMPLES)
+    p.add_argument("-n", "--node", help="node to attach to (default $CCOMM_NODE, else the hostname)")
+    p.add_argument("-o", "--output", help="MCAP file to write (default ccomm-NODE-DATE-TIME.mcap)")
+    p.add_argument("-s", "--signals", action="append", default=[], metavar="NAMES",
+                   help="signals to record: names or shell patterns (wheel*), comma-separated, "
+                        "repeatable (default: every signal this node produces or receives)")
+    p.add_argument("-d", "--duration", type=float, default=0, metavar="SEC",
+                   help="stop after SEC seconds (default: until SIGINT/SIGTERM)")
+    p.add_argument("--rotate-size", type=float, default=0, metavar="MB",
+                   help="start a new file (NAME-0000.mcap, NAME-0001.mcap, ...) every MB megabytes")
+    p.add_argument("--rotate-seconds", type=float, default=0, metavar="SEC",
+                   help="start a new file every SEC seconds")
+    p.add_argument("--compression", choices=["none", "lz4", "zstd"], default="lz4",
+                   help="chunk compression (default lz4: about 3x smaller, cheap)")
+    p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
+                   help="uncompressed chunk size (default 1 MiB; chunks also close every second)")
+    p.add_argument("--priority", type=int, default=0, metavar="N",
+                   help="SCHED_FIFO priority of the capture loop (the writer process gets 1; needs "
+                        "CAP_SYS_NICE); a state "
+                        "value replaced before the loop reads it is missed (counted as a gap)")
+    p.add_argument("--progress", choices=["auto", "lines", "none"], default="auto",
+                   help="progress on stderr: in place on a terminal (auto), a line every 5 s, none")
+    p.add_argument("-q", "--quiet", action="store_true", help="same as --progress none")
+    p.add_argument("--stats-json", metavar="FILE", help="write counts per signal (values, first/last "
+                                                         "seq, missed, lost) to FILE at the end")
+    p.add_argument("--list", action="store_true", help="print the signals that would be recorded, exit")
+    p.add_argument("--recover", metavar="FILE", help="read FILE (a recording cut short, e.g. by a "
+                                                     "kill -9 or a full disk) up to its last intact "
+                                                     "chunk and write a complete file to --output")
+    a = p.parse_args(argv)
+    if a.quiet:
+        a.progress = "none"
+    if a.duration < 0 or a.rotate_size < 0 or a.rotate_seconds < 0 or a.chunk_size < 1024:
+        p.error("--duration, --rotate-size and --rotate-seconds must be >= 0, --chunk-size >= 1024")
+    if a.recover and not a.output:
+        p.error("--recover needs --output (the file to write)")
+    return a
+
+
+def select_signals(all_signals: List[SignalDesc], patterns: List[str], node: str) -> List[SignalDesc]:
+    """The selected signals; raises ValueError with a clear message."""
+    readable = [d for d in all_signals if d.readable_here]
+    words = [w.strip() for arg in patterns for w in arg.split(",") if w.strip()]
+    if not words:
+        if not readable:
+            raise ValueError(f"node '{node}' neither produces nor receives any signal: nothing to record")
+        return readable
+    chosen: List[SignalDesc] = []
+    for w in words:
+        if any(ch in w for ch in "*?["):
+            hits = [d for d in readable if fnmatch.fnmatchcase(d.name, w)]
+            if not hits:
+                others = [d.name for d in all_signals if fnmatch.fnmatchcase(d.name, w)]
+                why = (f" (it matches {', '.join(others[:5])}, which node '{node}' neither produces "
+                       "nor receives)") if others else ""
+                raise ValueError(f"pattern '{w}' matches no signal node '{node}' holds{why}")
+        else:
+            hits = [d for d in all_signals if d.name == w]
+            if not hits:
+                raise ValueError(f"no signal '{w}' in the configuration (`ccomm list` shows them)")
+            if not hits[0].readable_here:
+                raise ValueError(f"signal '{w}' is produced by '{hits[0].producer}' and not delivered "
+                                 f"to node '{node}': record it on a node that consumes it")
+        chosen += [d for d in hits if d not in chosen]
+    return chosen
+
+
+def _set_priority(prio: int) -> None:
+    if prio > 0:
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio))
+        except OSError as e:
+            print(f"record: cannot use SCHED_FIFO priority {prio} ({e.strerror}); "
+                  "recording at normal priority", file=sys.stderr)
+
+
+def _write_all(fd: int, data: bytearray) -> None:
+    os.set_blocking(fd, True)
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _write_some(fd: int, pending: bytearray) -> None:
+    """Hands the writer what the pipe takes now (fd is non-blocking): a writer that falls
+    behind for a while (a loaded machine, a slow disk) delays values but never makes the
+    capture loop wait and miss them; they wait here, in memory."""
+    try:
+        n = os.write(fd, memoryview(pending)[:1 << 20])
+    except BlockingIOError:
+        return
+    del pending[:n]
+
+
+def capture(h: Handle, sigs: List[SignalDesc], fd: int, duration: float, stop: List[int],
+            writer_alive: Callable[[], bool]) -> int:
+    """Reads every new value of `sigs` until stopped; returns the exit status."""
+    handle, read, wait, now, set_time = h.h, h.read, h.wait, h.now, h.set_time
+    info = (ctypes.c_ubyte * struct.calcsize(INFO_FORMAT))()
+    info_addr = ctypes.addressof(info)
+    unpack_info = struct.Struct(INFO_FORMAT).unpack_from
+    pack = RECORD.pack
+    bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
+    # (index, id, buffer address, size, buffer view, is event) per signal, made once
+    items = [(i, d.id, ctypes.addressof(b), d.value_bytes, memoryview(b).cast("B"), d.is_event)
+             for i, (d, b) in enumerate(zip(sigs, bufs))]
+    last_seq = [0] * len(sigs)
+    out = bytearray()
+    pending = bytearray()
+    os.set_blocking(fd, False)
+    warned = False
+    start = now()
+    end = start + int(duration * 1e9) if duration > 0 else 0
+    last_send = last_check = start
+    while not stop:
+        wait(handle, 100)
+        t = now()
+        set_time(handle, t)  # ages against t: the arrival time is t - age, exactly
+        for i, sid, addr, size, view, event in items:
+            while True:
+                r = read(handle, sid, addr, size, info_addr)
+                if r < 0:
+                    print(f"record: reading {sigs[i].name} failed: {h.strerror(r)}", file=sys.stderr)
+                    return 1
+                if r >= 2:  # NEVER (no value yet) or EMPTY (no new event)
+                    break
+                status, flags, seq, age, src, lost = unpack_info(info)
+                if seq != last_seq[i]:
+                    last_seq[i] = seq
+                    out += pack(sid, status, flags, seq, t - age, src, lost)
+                    out += view
+                if not event:
+                    break
+        if len(out) >= 65536 or ((out or pending) and t - last_send >= 20_000_000):
+            pending += out
+            out.clear()
+            _write_some(fd, pending)
+            last_send = t
+        if t - last_check >= 1_000_000_000:
+            last_check = t
+            if not writer_alive():
+                return 1
+            if len(pending) > 256 << 20 and not warned:
+                warned = True
+                print("record: warning: the writer process is more than 256 MB behind (disk or CPU "
+                      "too slow); values wait in memory", file=sys.stderr)
+        if end and t >= end:
+            break
+    set_time(handle, 0)
+    pending += out
+    _write_all(fd, pending)
+    return 0
+
+
+def record(a: argparse.Namespace) -> int:
+    from .mcap_io.writer import WriterOptions, run_writer
+    try:
+        h = Handle(a.node)
+    except (CcommCallError, OSError) as e:
+        print(f"record: {e}", file=sys.stderr)
+        return 1
+    try:
+        sigs = select_signals(h.signals(), a.signals, h.node)
+    except ValueError as e:
+        print(f"record: {e}", file=sys.stderr)
+        return 2
+    if a.list:
+        for d in sigs:
+            print(f"{d.name}\t{d.type_text}\t{'event' if d.is_event else 'state'}\tfrom {d.producer}")
+        return 0
+    if not h.daemon_alive():
+        print(f"record: warning: ccommd of node '{h.node}' shows no heartbeat; recording what "
+              "the segment holds", file=sys.stderr)
+    output = a.output or time.strftime(f"ccomm-{h.node}-%Y%m%d-%H%M%S.mcap")
+    offset = time.clock_gettime_ns(time.CLOCK_REALTIME) - time.clock_gettime_ns(time.CLOCK_MONOTONIC)
+    opts = WriterOptions(output=output, signals=sigs, node=h.node, compression=a.compression,
+                         chunk_size=a.chunk_size, rotate_bytes=int(a.rotate_size * 1e6),
+                         rotate_seconds=a.rotate_seconds, clock_offset_ns=offset,
+                         progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns())
+    rfd, wfd = os.pipe()
+    try:  # room for about half a second of values at 100 000 values/s
+        import fcntl
+        fcntl.fcntl(wfd, 1031, 1 << 20)  # F_SETPIPE_SZ
+    except OSError:
+        pass
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        os.close(wfd)
+        code = 1
+        if a.priority > 0:  # above the machine's ordinary work, below the capture loop
+            _set_priority(1)
+        try:
+            code = run_writer(rfd, opts)
+        finally:
+            sys.stderr.flush()
+            os._exit(code)
+    os.close(rfd)
+    stop: List[int] = []
+    for s in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(s, lambda *_: stop.append(1))
+    if a.progress != "none":
+        print(f"record: node {h.node}, {len(sigs)} signals -> {output} (^C to stop)", file=sys.stderr)
+    _set_priority(a.priority)
+    gc.disable()  # the loop makes no cycles; a collection pause could miss a value
+    ended: List[int] = []
+
+    def writer_alive() -> bool:
+        if not ended:
+            done, wstatus = os.waitpid(pid, os.WNOHANG)
+            if done:
+                ended.append(os.waitstatus_to_exitcode(wstatus))
+        return not ended
+
+    try:
+        code = capture(h, sigs, wfd, a.duration, stop, writer_alive)
+    except BrokenPipeError:
+        code = 1
+    finally:
+        os.close(wfd)
+        h.close()
+    if not ended:
+        ended.append(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]))
+    wcode = ended[0]
+    if wcode != 0:
+        print(f"record: the writer process failed (exit {wcode}); see its message above",
+              file=sys.stderr)
+        return 1
+    _report_cpu(a)
+    return code
+
+
+def _report_cpu(a: argparse.Namespace) -> None:
+    """CPU seconds of the capture loop and of the writer, into --stats-json."""
+    me, child = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = {"cpu_capture_s": round(me.ru_utime + me.ru_stime, 3),
+           "cpu_writer_s": round(child.ru_utime + child.ru_stime, 3)}
+    if a.stats_json:
+        try:
+            with open(a.stats_json) as f:
+                s = json.load(f)
+            s.update(cpu)
+            with open(a.stats_json, "w") as f:
+                json.dump(s, f, indent=1)
+        except (OSError, ValueError) as e:
+            print(f"record: cannot update {a.stats_json}: {e}", file=sys.stderr)
+    if a.progress != "none":
+        print(f"record: CPU time: capture {cpu['cpu_capture_s']} s, writer {cpu['cpu_writer_s']} s",
+              file=sys.stderr)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    a = parse_args(argv)
+    if not require_mcap("record"):
+        return 1
+    if a.recover:
+        from .mcap_io.recording import RecordingError, recover
+        try:
+            n, why = recover(a.recover, a.output)
+        except RecordingError as e:
+            print(f"record: {e}", file=sys.stderr)
+            return 1
+        print(f"record: {a.output}: {n} messages recovered from {a.recover}" +
+              (f"; stopped at {why}" if why else " (the file was complete)"), file=sys.stderr)
+        return 0
+    return record(a)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,213 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ccomm-replay: writes the values of an MCAP recording back into the signals this node
+produces, at the original timing (the producer's write times), for hardware-in-the-loop
+regression. Values written at the same moment (one control cycle) leave in one frame."""
+from __future__ import annotations
+
+import argparse
+import fnmatch
+import json
+import os
+import signal
+import sys
+import time
+from typing import TYPE_CHECKING, Dict, List, Optional, Sequence, Tuple
+
+from .mcap_io import require_mcap
+from .mcap_io.capi import E_BUSY, E_FULL, OPEN_BATCH, CcommCallError, Handle, SignalDesc
+
+if TYPE_CHECKING:
+    from .mcap_io.recording import Recording
+
+EXAMPLES = """\
+examples:
+  ccomm-replay run.mcap                  every recorded signal this node produces, as recorded
+  ccomm replay --node control run.mcap   the same through the ccomm CLI
+  ccomm-replay --rate 2 --loop run.mcap  twice as fast, over and over until ^C
+  ccomm-replay -s 'wheel*' run.mcap      only these signals (an error if one is not produced here)
+
+Signals of the recording that other nodes produce are skipped (and listed) unless named
+in --signals, where they are an error; so are signals missing from this node's
+configuration or whose type or size changed. Exit status: 0 done, 1 runtime error,
+2 the recording does not fit this node (nothing is written then).
+"""
+
+
+def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(
+        prog="ccomm-replay", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Write the values of a ccomm-record MCAP file into the signals this node "
+                    "produces, at the recorded timing.", epilog=EXAMPLES)
+    p.add_argument("file", metavar="FILE.mcap", help="recording made by ccomm-record")
+    p.add_argument("-n", "--node", help="node to attach to (default $CCOMM_NODE, else the hostname)")
+    p.add_argument("-s", "--signals", action="append", default=[], metavar="NAMES",
+                   help="signals to replay: names or shell patterns, comma-separated, repeatable "
+                        "(default: every recorded signal this node produces)")
+    p.add_argument("-r", "--rate", type=float, default=1.0,
+                   help="speed factor: 2 = twice as fast (default 1: the recorded timing)")
+    p.add_argument("--loop", action="store_true", help="start again at the end, until SIGINT/SIGTERM")
+    p.add_argument("--priority", type=int, default=0, metavar="N",
+                   help="SCHED_FIFO priority (needs CAP_SYS_NICE): steadier timing")
+    p.add_argument("--check", action="store_true",
+                   help="check that the recording fits this node and print what would be replayed")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress or summary on stderr")
+    p.add_argument("--stats-json", metavar="FILE",
+                   help="write values written and timing error (ns: p50, p99, max) to FILE")
+    a = p.parse_args(argv)
+    if not a.rate > 0:
+        p.error("--rate must be > 0")
+    return a
+
+
+class Refusal(Exception):
+    """The recording does not fit this node: exit 2, nothing written."""
+
+
+def plan(rec: "Recording", descs: List[SignalDesc], patterns: List[str],
+         node: str) -> Tuple[List[Tuple[SignalDesc, str]], List[str]]:
+    """(signals to replay as (desc, recorded name), notes about skipped ones)."""
+    words = [w.strip() for arg in patterns for w in arg.split(",") if w.strip()]
+    by_name: Dict[str, SignalDesc] = {d.name: d for d in descs}
+    named = {w for w in words if not any(c in w for c in "*?[")}
+    for w in named:
+        if w not in rec.signals:
+            raise Refusal(f"signal '{w}' is not in {rec.path} (it has {len(rec.signals)} signals)")
+    for w in words:
+        if w not in named and not any(fnmatch.fnmatchcase(n, w) for n in rec.signals):
+            raise Refusal(f"pattern '{w}' matches no signal of {rec.path}")
+    chosen, notes = [], []
+    for name, rs in rec.signals.items():
+        if words and not any(fnmatch.fnmatchcase(name, w) for w in words):
+            continue
+        d = by_name.get(name)
+        if d is None:
+            raise Refusal(f"signal '{name}' of {rec.path} does not exist on node '{node}': the "
+                          "recording is of another configuration (select signals with --signals)")
+        if d.type != rs.type or d.count != rs.count or d.is_event != rs.is_event:
+            kind = lambda e: "event" if e else "state"  # noqa: E731
+            raise Refusal(f"signal '{name}' was recorded as {kind(rs.is_event)} {rs.type_text}, but "
+                          f"node '{node}' has it as {kind(d.is_event)} {d.type_text}: the "
+                          "configuration changed since the recording")
+        if not d.produced_here:
+            if name in named:
+                raise Refusal(f"signal '{name}' is produced by '{d.producer}', not by node '{node}': "
+                              "replay it there")
+            notes.append(name)
+            continue
+        chosen.append((d, name))
+    if not chosen:
+        raise Refusal(f"node '{node}' produces none of the signals to replay from {rec.path} "
+                      f"(they come from {', '.join(sorted({rec.signals[n].producer for n in notes}))})")
+    return chosen, notes
+
+
+def _percentile(sorted_vals: List[int], q: float) -> int:
+    if not sorted_vals:
+        return 0
+    return sorted_vals[min(len(sorted_vals) - 1, int(q * len(sorted_vals)))]
+
+
+def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, loop: bool,
+           stop: List[int], quiet: bool) -> Tuple[int, List[int]]:
+    """Writes the timeline ((source time, seq, signal id, value)); returns (values written,
+    lateness of each write in ns)."""
+    handle, write, flush, now = h.h, h.write, h.flush, time.monotonic_ns
+    t0 = timeline[0][0]
+    span = timeline[-1][0] - t0
+    late: List[int] = []
+    written = 0
+    start = now() + 20_000_000
+    last_report = now()
+    while not stop:
+        for t, _seq, sid, data in timeline:
+            target = start + int((t - t0) / rate)
+            n = now()
+            if target > n:
+                flush(handle)  # the values due before now leave together
+                time.sleep((target - n) / 1e9)  # clock_nanosleep: about 60 us late at most, idle
+                if stop:
+                    break
+            r = write(handle, sid, data, len(data))
+            tries = 0
+            while r in (E_FULL, E_BUSY) and tries < 1000 and not stop:
+                flush(handle)  # an event ring is full: give ccommd a moment
+                time.sleep(0.001)
+                tries += 1
+                r = write(handle, sid, data, len(data))
+            if r < 0:
+                raise CcommCallError(r, f"writing signal {sid} failed: {h.strerror(r)}")
+            late.append(now() - target)
+            written += 1
+            if not quiet and now() - last_report >= 1_000_000_000:
+                last_report = now()
+                print(f"\rreplay: {(t - t0) / 1e9:7.1f} / {span / 1e9:.1f} s  {written} values",
+                      end="", file=sys.stderr, flush=True)
+        flush(handle)
+        if not loop:
+            break
+        start += int(span / rate) + int((span / max(len(timeline) - 1, 1)) / rate)
+    return written, late
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    a = parse_args(argv)
+    if not require_mcap("replay"):
+        return 1
+    from .mcap_io.recording import RecordingError, load
+    words = [w.strip() for arg in a.signals for w in arg.split(",") if w.strip()]
+    try:
+        h = Handle(a.node, OPEN_BATCH)
+        descs = h.signals()
+    except (CcommCallError, OSError) as e:
+        print(f"replay: {e}", file=sys.stderr)
+        return 1
+    produced = {d.name for d in descs if d.produced_here}
+
+    def wanted(name: str) -> bool:  # the values plan() can choose
+        return name in produced and (not words or any(fnmatch.fnmatchcase(name, w) for w in words))
+
+    try:
+        rec = load(a.file, wanted)
+        chosen, skipped = plan(rec, descs, a.signals, h.node)
+    except (RecordingError, Refusal) as e:
+        print(f"replay: {e}", file=sys.stderr)
+        return 2
+    timeline = sorted((t, seq, d.id, data) for d, name in chosen for t, seq, data in rec.signals[name].values)
+    if not a.quiet:
+        print(f"replay: {len(timeline)} values of {len(chosen)} signals from {a.file} "
+              f"(recorded on '{rec.node}') into node '{h.node}'", file=sys.stderr)
+        if skipped:
+            print(f"replay: skipped {len(skipped)} signals other nodes produce: "
+                  f"{', '.join(skipped[:8])}{' ...' if len(skipped) > 8 else ''}", file=sys.stderr)
+    if a.check or not timeline:
+        return 0
+    stop: List[int] = []
+    for s in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(s, lambda *_: stop.append(1))
+    if a.priority > 0:
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(a.priority))
+        except OSError as e:
+            print(f"replay: cannot use SCHED_FIFO priority {a.priority} ({e.strerror})", file=sys.stderr)
+    try:
+        written, late = replay(h, timeline, a.rate, a.loop, stop, a.quiet)
+    except CcommCallError as e:
+        print(f"\nreplay: {e}", file=sys.stderr)
+        return 1
+    finally:
+        h.close()
+    late.sort()
+    stats = {"values": written, "signals": len(chosen), "late_p50_ns": _percentile(late, 0.5),
+             "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0}
+    if not a.quiet:
+        print(f"\rreplay: wrote {written} values; timing error p50 {stats['late_p50_ns'] / 1e3:.0f} us, "
+              f"p99 {stats['late_p99_ns'] / 1e3:.0f} us, max {stats['late_max_ns'] / 1e3:.0f} us",
+              file=sys.stderr)
+    if a.stats_json:
+        with open(a.stats_json, "w") as f:
+            json.dump(stats, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,203 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Checks of the record suite (tests/record/run), run in its venv. Reads recordings with
+the `mcap` package's own reader only (not ccomm's code), so a wrong writer cannot hide.
+`written` and `same` exit 0 when exact, 1 when a value is wrong, duplicated, out of order
+or missing without a gap field saying so, 3 when values are only missing (each accounted
+for) or late: what an overloaded host causes (a state value replaced before anyone read it).
+
+  recordcheck.py config SRC.xml OUT.xml            three-node config: SRC's two nodes + monitor
+  recordcheck.py written FILE.mcap CONFIG NODE=SENT.json...  every value ccomm-latency wrote is in FILE
+  recordcheck.py same ORIG.mcap REPLAYED.mcap MS   same values in the same order, timing within MS
+  recordcheck.py throughput STATS.json RATE        the recorder missed nothing at >= RATE values/s
+  recordcheck.py forge OUT.mcap other|changed|foreign   a recording replay must refuse
+  recordcheck.py corrupt IN.mcap OUT.mcap         IN with bytes of its first chunk overwritten
+  recordcheck.py count FILE.mcap                   number of messages (mcap's own reader)
+"""
+import json
+import re
+import sys
+from collections import defaultdict
+
+from mcap.reader import make_reader
+
+
+def make_config(src: str, out: str) -> None:
+    """The demo's setup-simulation with a third node 'monitor' that consumes every signal,
+    all on loopback UDP (127.0.0.1-3 inside the suite's own network namespace)."""
+    x = open(src).read()
+    x = x.replace('ip="10.42.0.1"', 'ip="127.0.0.1"').replace('ip="10.42.0.2"', 'ip="127.0.0.2"')
+    x = x.replace('interface="eth0"', 'interface="lo"')
+    x = x.replace('consumers="planner"', 'consumers="planner,monitor"')
+    x = x.replace('consumers="control"', 'consumers="control,monitor"')
+    monitor = ('  <node name="monitor" interface="lo" ip="127.0.0.3" transport="udp">\n'
+               '    <realtime mlockall="true" priority="80"/>\n  </node>\n')
+    x = re.sub(r"(\n  <!--[^\n]*\n  <signal )", "\n" + monitor + r"\1", x, count=1)
+    if "monitor" not in x.split("<signal", 1)[0]:
+        raise SystemExit("config: could not add the monitor node to " + src)
+    open(out, "w").write(x)
+
+
+def read_values(path: str):
+    """{topic: [(seq, value, source_time_ns, receive_time_ns, gap)]} in file order."""
+    out = defaultdict(list)
+    with open(path, "rb") as f:
+        r = make_reader(f)
+        for _schema, channel, message in r.iter_messages(log_time_order=False):
+            m = json.loads(message.data)
+            out[channel.topic].append((m["seq"], m["value"], m["source_time_ns"], m["receive_time_ns"],
+                                       m["gap"]))
+    return out
+
+
+def produced_by(config: str, node: str) -> list:
+    return re.findall(r'<signal name="([^"]+)" type="double" producer="%s"' % node, open(config).read())
+
+
+def check_written(path: str, config: str, sent_files: list) -> int:
+    """ccomm-latency writes its cycle number k = 1, 2, ... to every double its node
+    produces, so on fresh daemons value == seq == k for k = 1..sent. sent_files: NODE=JSON
+    (ccomm-latency's output)."""
+    got = read_values(path)
+    wrong = missing = total = nsig = 0
+    for arg in sent_files:
+        node, sf = arg.split("=", 1)
+        sent, names = json.load(open(sf))["sent"], produced_by(config, node)
+        nsig += len(names)
+        for name in names:
+            vals = got.get(name, [])
+            total += len(vals)
+            seqs = [v[0] for v in vals]
+            bad = [v for v in vals if not 1 <= v[0] <= sent or v[1] != float(v[0])]
+            unordered = sum(1 for a, b in zip(seqs, seqs[1:]) if b <= a)
+            unaccounted = sum(1 for a, b in zip(vals, vals[1:]) if b[0] - a[0] - 1 != b[4])
+            miss = sent - len(vals)
+            if bad or unordered or unaccounted:
+                wrong += 1
+                print(f"# {name}: WRONG: {len(bad)} values != seq or out of 1..{sent} (e.g. {bad[:2]}), "
+                      f"{unordered} out of order, {unaccounted} gaps not in the gap field")
+            elif miss:
+                gone = sorted(set(range(1, sent + 1)) - set(seqs))
+                print(f"# {name}: {len(vals)} of {sent} values; missing seq {gone[:8]}"
+                      f"{' ...' if len(gone) > 8 else ''} (each one in a gap field or before the first)")
+            missing += miss
+    print(f"# recording: {total} values of {nsig} signals, {missing} missing, {wrong} signals wrong")
+    if wrong:
+        return 1
+    return 3 if missing else 0
+
+
+def check_same(orig: str, replayed: str, tol_ms: float) -> int:
+    """On fresh daemons the replaying node numbers its writes 1, 2, ...: the replayed
+    value with seq k must equal the k-th recorded value, and its time offset from the first
+    write must be within tol_ms of the recorded one."""
+    a, b = read_values(orig), read_values(replayed)
+    if sorted(a) != sorted(b):
+        print(f"# signals differ: only in original {sorted(set(a) - set(b))[:5]}, "
+              f"only in replay {sorted(set(b) - set(a))[:5]}")
+        return 1
+    t0a = min(v[0][2] for v in a.values() if v)
+    t0b = min(v[0][2] for v in b.values() if v)
+    wrong = missing = n = 0
+    errs = []
+    for name in sorted(a):
+        va, vb = a[name], b[name]
+        seqs = [v[0] for v in vb]
+        bad = [v for v in vb if not 1 <= v[0] <= len(va) or v[1] != va[v[0] - 1][1]]
+        unordered = sum(1 for x, y in zip(seqs, seqs[1:]) if y <= x)
+        unaccounted = sum(1 for x, y in zip(vb, vb[1:]) if y[0] - x[0] - 1 != y[4])
+        if bad or unordered or unaccounted:
+            wrong += 1
+            print(f"# {name}: WRONG: {len(bad)} replayed values differ from the recorded ones "
+                  f"(e.g. {bad[:2]}), {unordered} out of order, {unaccounted} gaps not in the gap field")
+            continue
+        if len(vb) != len(va):
+            print(f"# {name}: {len(vb)} of {len(va)} replayed values in the second recording; "
+                  f"missing {sorted(set(range(1, len(va) + 1)) - set(seqs))[:8]}")
+        missing += len(va) - len(vb)
+        for y in vb:
+            x = va[y[0] - 1]
+            errs.append(abs((y[2] - t0b) - (x[2] - t0a)))
+            n += 1
+    errs.sort()
+    worst = errs[-1] if errs else 0
+    p99 = errs[int(0.99 * (len(errs) - 1))] if errs else 0
+    print(f"# replay: {n} values equal and in order, {missing} missing; timing error p99 "
+          f"{p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance {tol_ms} ms)")
+    if wrong:
+        return 1
+    return 3 if missing or worst > tol_ms * 1e6 else 0
+
+
+def check_throughput(stats_path: str, rate: float) -> int:
+    s = json.load(open(stats_path))
+    print(f"# throughput: {s['values']} values in {s['seconds']} s = {s['values_per_s']:.0f}/s, "
+          f"missed by the recorder {s['recorder_missed']}, lost in ccomm {s['ccomm_lost']}")
+    return 0 if s["values_per_s"] >= rate and s["recorder_missed"] == 0 and s["ccomm_lost"] == 0 else 1
+
+
+def forge(out: str, kind: str) -> None:
+    """A recording that must not replay: 'other' has a signal no ccomm config here has,
+    'changed' has wheel0_pos as int32[2], 'foreign' is an MCAP file of another program."""
+    from mcap.writer import Writer
+    with open(out, "wb") as f:
+        w = Writer(f)
+        w.start()
+        if kind == "foreign":
+            sid = w.register_schema("geometry/Point", "jsonschema", b"{}")
+            ch = w.register_channel("/point", "json", sid)
+            w.add_message(ch, 1, b'{"x": 1}', 1)
+        else:
+            name, typ, count = ("no_such_signal", "double", 1) if kind == "other" else ("wheel0_pos", "int32", 2)
+            sid = w.register_schema("ccomm." + typ, "jsonschema", b"{}")
+            ch = w.register_channel(name, "json", sid, {"ccomm.signal": name, "ccomm.type": typ,
+                                                          "ccomm.count": str(count), "ccomm.event": "0",
+                                                          "ccomm.producer": "control"})
+            value = 1.0 if count == 1 else [1, 2]
+            w.add_message(ch, 1, json.dumps({"value": value, "seq": 1, "source_time_ns": 1,
+                                             "receive_time_ns": 1, "status": "fresh", "lost": 0,
+                                             "gap": 0}).encode(), 1)
+        w.finish()
+
+
+def corrupt(src: str, out: str) -> None:
+    """A copy of src with 256 bytes in the middle of its first chunk's data overwritten
+    (bytes elsewhere, e.g. in a message index, might not matter to a reader)."""
+    data = bytearray(open(src, "rb").read())
+    with open(src, "rb") as f:
+        chunk = make_reader(f).get_summary().chunk_indexes[0]
+    mid = chunk.chunk_start_offset + chunk.chunk_length // 2
+    data[mid:mid + 256] = b"\x55" * 256
+    open(out, "wb").write(data)
+
+
+def count_messages(path: str) -> int:
+    with open(path, "rb") as f:
+        return sum(1 for _ in make_reader(f).iter_messages())
+
+
+def main() -> int:
+    cmd, args = sys.argv[1], sys.argv[2:]
+    if cmd == "config":
+        make_config(*args)
+        return 0
+    if cmd == "written":
+        return check_written(args[0], args[1], args[2:])
+    if cmd == "same":
+        return check_same(args[0], args[1], float(args[2]))
+    if cmd == "throughput":
+        return check_throughput(args[0], float(args[1]))
+    if cmd == "forge":
+        forge(args[0], args[1])
+        return 0
+    if cmd == "corrupt":
+        corrupt(args[0], args[1])
+        return 0
+    if cmd == "count":
+        print(count_messages(args[0]))
+        return 0
+    print(__doc__, file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

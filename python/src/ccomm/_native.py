@@ -124,9 +124,18 @@ def lib() -> ctypes.CDLL:
 
 
 def library_path() -> str:
-    """Path (or soname) of the libccomm this process uses; loads it if needed."""
+    """File of the libccomm this process uses (loads it if needed): where the dynamic
+    loader mapped it from, also when it was loaded by soname."""
     lib()
     assert _lib_path is not None
+    try:
+        with open("/proc/self/maps") as maps:
+            for line in maps:
+                path = line.split(maxsplit=5)[-1].strip()
+                if os.path.basename(path).startswith("libccomm.so"):
+                    return path
+    except OSError:
+        pass
     return _lib_path
 
 

@@ -1,0 +1,80 @@
+#!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
+# Runs inside the clean Debian root made by tests/packages/run (chroot, no network): what
+# a PC user does with the packages. Files in /srv/ccomm-test: debs/, wheel/, wheelhouse/
+# (numpy), consumer/ (the C and C++ programs), talk.py, local-only.xml.
+# Environment: CCOMM_VERSION (the packages' version). Exit 0 if every check passed.
+set -uo pipefail
+T=/srv/ccomm-test
+export DEBIAN_FRONTEND=noninteractive
+passed=0 failed=0
+check() {  # check "description" command...: counts, and shows the output of a failure
+  local what=$1 out
+  shift
+  if out=$("$@" 2>&1); then
+    passed=$((passed + 1)); echo "ok - $what"
+  else
+    failed=$((failed + 1)); echo "not ok - $what"; sed 's/^/    /' <<<"$out" | tail -25
+  fi
+}
+quiet_ok() { "$@" >/dev/null 2>&1; }
+
+# ---- the packages install, offline ------------------------------------------------------
+check "apt install ./*.deb (ccommd libccomm0 libccomm-dev python3-ccomm)" \
+  apt-get install -y -q --no-install-recommends -o Debug::NoLocking=1 "$T"/debs/*.deb
+for p in ccommd libccomm0 libccomm-dev python3-ccomm; do
+  check "$p $CCOMM_VERSION installed" bash -c "dpkg-query -W -f='\${Status} \${Version}' $p | grep -qx 'install ok installed $CCOMM_VERSION'"
+done
+check "system user and group ccomm (sysusers at configure)" bash -c 'getent passwd ccomm && getent group ccomm'
+check "ccommd.service enabled (not started)" test -L /etc/systemd/system/multi-user.target.wants/ccommd.service
+check "/etc/ccomm/signals.xml is a conffile" bash -c "dpkg-query -W -f='\${Conffiles}' ccommd | grep -q /etc/ccomm/signals.xml"
+check "the installed signals.xml passes ccommd --check" ccommd --check /etc/ccomm/signals.xml
+check "ccommd --version says $CCOMM_VERSION" bash -c "ccommd --version | grep -q '$CCOMM_VERSION'"
+
+# ---- ccommd, started directly (no systemd in a chroot) ------------------------------------
+ccommd --config "$T/local-only.xml" --node robot --no-rt >"$T/ccommd.log" 2>&1 &
+daemon=$!
+up() {
+  local i
+  for i in $(seq 100); do
+    ccomm --node robot list >/dev/null 2>&1 && return 0
+    kill -0 "$daemon" 2>/dev/null || { cat "$T/ccommd.log"; return 1; }
+    sleep 0.1
+  done
+  cat "$T/ccommd.log"; return 1
+}
+check "ccommd runs node robot (examples/local-only.xml)" up
+
+# ---- the user's C and C++ programs, built against the installed headers -------------------
+check "cmake: find_package(ccomm) project configures and builds" bash -c \
+  "cmake -S $T/consumer -B $T/build-cmake && cmake --build $T/build-cmake"
+check "pkg-config ccomm: C++ program (ccomm.hpp) builds" bash -c \
+  "g++ -std=c++17 -Wall -Wextra -Werror -o $T/joint_reader $T/consumer/joint_reader.cpp \$(pkg-config --cflags --libs ccomm)"
+check "the find_package(ccomm) program writes joint_pos" "$T/build-cmake/joint_writer" 10
+check "the pkg-config program reads it and writes drive_ok" "$T/joint_reader" 10
+check "the installed CLI echoes joint_pos" bash -c "ccomm --node robot echo joint_pos --once | grep -q '10'"
+check "the programs link the installed libccomm.so.0" bash -c \
+  "ldd $T/build-cmake/joint_writer | grep -E 'libccomm.so.0 => /(usr/)?lib/' && ldd $T/joint_reader | grep -E 'libccomm.so.0 => /(usr/)?lib/'"
+
+# ---- Python: the Debian package, then the wheel in a fresh venv ----------------------------
+check "python3-ccomm talks to ccommd" \
+  python3 "$T/talk.py" --version "$CCOMM_VERSION" --library-under /usr/lib/ --library-under /lib/ --base 10
+check "python3 -m venv (no system site packages)" python3 -m venv "$T/venv"
+check "pip install ccomm-*.whl (numpy from the local wheelhouse, nothing else)" \
+  "$T/venv/bin/pip" install -q --disable-pip-version-check --no-index --find-links "$T/wheelhouse" "$T"/wheel/ccomm-*.whl
+check "the wheel's libccomm needs only system libraries" bash -c \
+  "! ldd $T/venv/lib/python3*/site-packages/ccomm/_lib/libccomm.so.0 | grep -q 'not found'"
+check "the wheel (its own libccomm) talks to ccommd" bash -c \
+  "cd / && $T/venv/bin/python $T/talk.py --version $CCOMM_VERSION --library-under $T/venv/ --base 10"
+
+# ---- stop and remove ---------------------------------------------------------------------
+kill -TERM "$daemon"
+wait "$daemon"
+stopped=$?
+check "ccommd stops cleanly on SIGTERM (exit 0)" test "$stopped" -eq 0
+check "apt purge removes the packages" \
+  apt-get purge -y -q -o Debug::NoLocking=1 ccommd libccomm0 libccomm-dev python3-ccomm
+check "nothing of ccommd left but the user" bash -c "! test -e /etc/ccomm/signals.xml && ! test -e /usr/bin/ccommd"
+
+echo "packages: $passed passed, $failed failed"
+[[ $failed -eq 0 ]]

@@ -203,3 +203,27 @@ def test_write_while_ccommd_is_down_tells_the_caller(build_dir: Path, node: str,
         log.close()
         if seg.exists():
             seg.unlink()
+
+
+def test_the_wheels_bundled_library_comes_first(tmp_path: Path) -> None:
+    from ccomm import _native
+
+    bundled = tmp_path / "site" / "ccomm" / "_lib" / "libccomm.so.0"
+    bundled.parent.mkdir(parents=True)
+    bundled.write_text("")
+    build = tmp_path / "build-x"
+    (build / "lib").mkdir(parents=True)
+    (build / "lib" / "libccomm.so.0").write_text("")
+    env = {"CCOMM_BUILD_DIR": str(build)}
+    assert _native.find_library(env, [], bundled) == str(bundled)  # before any build tree
+    explicit = tmp_path / "mine.so"
+    explicit.write_text("")
+    assert _native.find_library({**env, "CCOMM_LIBRARY": str(explicit)}, [], bundled) == str(explicit)
+    bundled.unlink()  # a source install has none: the build directory is next
+    assert _native.find_library(env, [], bundled) == str(build / "lib" / "libccomm.so.0")
+
+
+def test_library_path_is_the_mapped_file(client: Client) -> None:
+    path = ccomm.library_path()
+    assert os.path.isabs(path) and os.path.basename(path).startswith("libccomm.so")
+    assert os.path.samefile(path, os.environ["CCOMM_LIBRARY"])

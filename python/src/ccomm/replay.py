@@ -84,7 +84,8 @@ def plan(rec: "Recording", descs: List[SignalDesc], patterns: List[str],
             raise Refusal(f"signal '{name}' of {rec.path} does not exist on node '{node}': the "
                           "recording is of another configuration (select signals with --signals)")
         if d.type != rs.type or d.count != rs.count or d.is_event != rs.is_event:
-            kind = lambda e: "event" if e else "state"  # noqa: E731
+            def kind(event: bool) -> str:
+                return "event" if event else "state"
             raise Refusal(f"signal '{name}' was recorded as {kind(rs.is_event)} {rs.type_text}, but "
                           f"node '{node}' has it as {kind(d.is_event)} {d.type_text}: the "
                           "configuration changed since the recording")

@@ -97,7 +97,7 @@ class Handle:
         self.now = L.ccomm_now
 
     def strerror(self, code: int) -> str:
-        s = self.lib.ccomm_strerror(code)
+        s: Optional[bytes] = self.lib.ccomm_strerror(code)
         return s.decode() if s else f"error {code}"
 
     def signals(self) -> List[SignalDesc]:

@@ -8,7 +8,7 @@ import math
 import os
 import struct
 from dataclasses import dataclass, field
-from typing import Callable, Dict, Iterator, List, Optional, Set, Tuple
+from typing import Any, Callable, Dict, Iterator, List, Optional, Set, Tuple
 
 from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
@@ -135,9 +135,10 @@ def load(path: str, wanted: Optional[Callable[[str], bool]] = None) -> Recording
             if rec.channel_id not in channels:
                 raise RecordingError(f"{path}: message {messages} is on channel {rec.channel_id}, "
                                      "which the file never declared")
-            sig = channels[rec.channel_id]
-            if sig is None:
+            wanted_sig = channels[rec.channel_id]
+            if wanted_sig is None:
                 continue
+            sig = wanted_sig
             try:
                 m = json.loads(rec.data)
                 sig.values.append((int(m["source_time_ns"]), int(m["seq"]),
@@ -165,7 +166,7 @@ def recover(src: str, dst: str) -> Tuple[int, str]:
         out = open(dst, "wb")
     except OSError as e:
         raise RecordingError(f"{dst}: cannot write: {e.strerror}") from None
-    w = Writer(out, compression=CompressionType.LZ4)
+    w: Any = Writer(out, compression=CompressionType.LZ4)  # its methods are not annotated
     w.start(profile="", library="ccomm-record --recover")
     schema_ids: Dict[int, int] = {}
     channel_ids: Dict[int, int] = {}

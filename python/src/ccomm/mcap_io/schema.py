@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import json
 import struct
-from typing import Callable, Dict, Tuple
+from typing import Any, Callable, Dict, Tuple
 
 from .capi import STATUS_NAMES, TYPE_FORMATS, SignalDesc
 
@@ -53,8 +53,8 @@ def schema_name(desc: SignalDesc) -> str:
 
 def json_schema(desc: SignalDesc) -> bytes:
     """JSON Schema of one signal's messages (one schema per type and count)."""
-    elem = {"type": [_JSON_TYPES[desc.type], "null"]}
-    value = elem if desc.count == 1 else {"type": "array", "items": elem,
+    elem: Dict[str, Any] = {"type": [_JSON_TYPES[desc.type], "null"]}
+    value: Dict[str, Any] = elem if desc.count == 1 else {"type": "array", "items": elem,
                                           "minItems": desc.count, "maxItems": desc.count}
     integer = {"type": "integer"}
     schema = {

@@ -17,7 +17,7 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import IO, Dict, List, Optional
+from typing import IO, Any, Dict, List, Optional
 
 from mcap.writer import CompressionType, Writer
 
@@ -76,7 +76,7 @@ class RecordingWriter:
         self.files = FileSet()
         self.values = 0
         self.stream: Optional[IO[bytes]] = None
-        self.mcap: Optional[Writer] = None
+        self.mcap: Any = None  # mcap.writer.Writer (its methods are not annotated)
         self.channel: Dict[int, int] = {}
         self.file_opened = 0.0
         self.rotating = o.rotate_bytes > 0 or o.rotate_seconds > 0
@@ -167,7 +167,7 @@ class RecordingWriter:
     def ccomm_lost_total(self) -> int:
         return sum(s.last_lost - s.first_lost for s in self.stats.values() if s.values)
 
-    def summary(self, seconds: float) -> dict:
+    def summary(self, seconds: float) -> Dict[str, Any]:
         return {
             "node": self.o.node, "files": self.files.paths, "seconds": round(seconds, 3),
             "values": self.values, "bytes": self.total_bytes(),

@@ -63,6 +63,7 @@ const domRow = (page, signal) => page.evaluate((s) => {
   const c = window.ccommView.charts[s];
   return { status: tr.querySelector(".status").textContent, value: tr.querySelector(".value").textContent,
            seq: tr.querySelector(".seq").textContent, lost: tr.querySelector(".lost").textContent,
+           skipped: tr.querySelector(".skipped").textContent,
            chartLast: chart ? chart.dataset.last : null, chartPoints: chart ? Number(chart.dataset.points || 0) : 0,
            plotted: c ? c.plot.data[1].slice(-1)[0] : undefined, series: c ? c.plot.series.length - 1 : 0 };
 }, signal);
@@ -72,7 +73,7 @@ const canvasPixels = (page, signal) => page.evaluate((s) =>
 const probe = new FoxgloveProbe(WS_URL);
 let browser, page, browser2, page2;
 const requests = [];
-const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "unused_sp", "mode_request"].map((s) => "/ccomm/" + s);
+const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "unused_sp", "mode_request"];  // topic = signal name
 
 await check("protocol client: every signal advertised as a JSON channel with a jsonschema", async () => {
   await probe.connect();
@@ -82,17 +83,22 @@ await check("protocol client: every signal advertised as a JSON channel with a j
     assert(ch, "advertised: " + t);
     assert(ch.encoding === "json" && ch.schemaEncoding === "jsonschema", t + ": " + ch.encoding + "/" + ch.schemaEncoding);
     const schema = JSON.parse(ch.schema);
-    for (const f of ["value", "seq", "source_time_ns", "age_ns", "status", "lost"]) assert(schema.properties[f], t + " schema lacks " + f);
+    // the fields of a `ccomm record` recording, plus age_ns
+    for (const f of ["value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status", "fresh", "safe_value", "lost", "gap"]) {
+      assert(schema.properties[f] && schema.required.includes(f), t + " schema lacks " + f);
+    }
   }
-  const joint = JSON.parse(probe.channels.get("/ccomm/joint_pos").schema).properties.value;
-  assert(joint.type === "array" && joint.maxItems === 3 && joint.items.type === "number", "joint_pos value schema " + JSON.stringify(joint));
-  assert(JSON.parse(probe.channels.get("/ccomm/tick").schema).properties.value.type === "integer", "tick is integer");
+  const joint = JSON.parse(probe.channels.get("joint_pos").schema).properties.value;
+  assert(joint.type === "array" && joint.maxItems === 3 && joint.items.type[0] === "number", "joint_pos value schema " + JSON.stringify(joint));
+  assert(JSON.parse(probe.channels.get("tick").schema).properties.value.type[0] === "integer", "tick is integer");
+  assert(probe.channels.get("joint_pos").schemaName === "ccomm.double[3]", "schema name " + probe.channels.get("joint_pos").schemaName);
   for (const t of topics) probe.subscribe(t);
 });
 
 await check("protocol client: a never-written signal decodes as status never, seq 0, age null", async () => {
-  const m = await probe.waitFor("/ccomm/unused_sp", () => true, 3000, "any message");
-  assert(m.status === "never" && m.seq === 0 && m.age_ns === null && m.lost === 0, JSON.stringify(m));
+  const m = await probe.waitFor("unused_sp", () => true, 3000, "any message");
+  assert(m.status === "never" && m.seq === 0 && m.age_ns === null && m.receive_time_ns === null && m.lost === 0 &&
+         m.fresh === false && m.gap === 0, JSON.stringify(m));
 });
 
 await check("page loads in headless Chromium, from the server only (no other origin)", async () => {
@@ -121,7 +127,7 @@ await check("the plot follows a value written with ccomm pub (DOM, plot data and
   pub("wheel_pos", 1.25);
   await until(async () => { const r = await domRow(page, "wheel_pos"); return r.value === "1.25" && r.plotted === 1.25; },
     5000, "wheel_pos 1.25 in table and plot");
-  await probe.waitFor("/ccomm/wheel_pos", (m) => m.value === 1.25 && m.status === "fresh", 3000, "1.25 fresh");
+  await probe.waitFor("wheel_pos", (m) => m.value === 1.25 && m.status === "fresh", 3000, "1.25 fresh");
   await sleep(300);
   const before = await canvasPixels(page, "wheel_pos");
   pub("wheel_pos", -2.5);
@@ -130,20 +136,20 @@ await check("the plot follows a value written with ccomm pub (DOM, plot data and
   assert(r.chartPoints >= 2, "points " + r.chartPoints);
   await sleep(200);
   assert((await canvasPixels(page, "wheel_pos")) !== before, "the chart's pixels did not change");
-  const m = await probe.waitFor("/ccomm/wheel_pos", (m) => m.value === -2.5, 3000, "value -2.5");
+  const m = await probe.waitFor("wheel_pos", (m) => m.value === -2.5, 3000, "value -2.5");
   assert(m.status === "fresh" && m.seq >= 2, JSON.stringify(m));
 });
 
 await check("a signal that is not written goes stale: badge and protocol message say so", async () => {
   const r = await until(async () => { const r = await domRow(page, "wheel_pos"); return r.status === "stale" && r; }, 3000, "wheel_pos stale");
   assert(r.value === "-2.5", "stale value " + r.value);
-  const m = await probe.waitFor("/ccomm/wheel_pos", (m) => m.status === "stale" && m.value === -2.5, 3000, "-2.5 stale");
+  const m = await probe.waitFor("wheel_pos", (m) => m.status === "stale" && m.value === -2.5, 3000, "-2.5 stale");
   assert(m.age_ns >= 300e6, JSON.stringify(m));
 });
 
 // The writer runs while the first browser is killed: the probe must miss nothing.
 const c0 = (await stats()).changes.tick;
-const seq0 = (probe.last("/ccomm/tick") || { seq: 0 }).seq;
+const seq0 = (probe.last("tick") || { seq: 0 }).seq;
 const writer = spawn(env("PYTHON"), [env("WRITER"), NODE, String(WRITER_RATE), String(WRITER_COUNT)], { stdio: ["ignore", "pipe", "inherit"] });
 let writerOut = "";
 writer.stdout.on("data", (d) => { writerOut += d; });
@@ -219,17 +225,22 @@ await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page
 await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {
   const code = await writerDone;
   assert(code === 0 && writerOut.includes("writer: done " + WRITER_COUNT), "writer exit " + code + ": " + writerOut);
-  await probe.waitFor("/ccomm/tick", (m) => m.value === WRITER_COUNT, 3000, "the last tick");
+  await probe.waitFor("tick", (m) => m.value === WRITER_COUNT, 3000, "the last tick");
   await sleep(300);
   const c1 = (await stats()).changes.tick;
-  const ticks = probe.received("/ccomm/tick").map((m) => m.msg).filter((m) => m.seq > seq0);
+  const ticks = probe.received("tick").map((m) => m.msg).filter((m) => m.seq > seq0);
   const seqs = [...new Set(ticks.map((m) => m.seq))];
   for (let i = 1; i < ticks.length; i++) assert(ticks[i].seq >= ticks[i - 1].seq, "seq went back at " + i);
   assert(seqs.length === c1 - c0, `probe saw ${seqs.length} new tick values, the server published ${c1 - c0}`);
+  // every value written is accounted for: received, or counted in a message's gap
+  const gaps = ticks.reduce((sum, m) => sum + m.gap, 0);
+  assert(seqs.length + gaps === WRITER_COUNT, `${seqs.length} received + ${gaps} in gaps != ${WRITER_COUNT} written`);
+  const row = await domRow(page2, "tick");
+  assert(Number(row.skipped) >= 0 && row.value === String(WRITER_COUNT), "page 2 tick row " + JSON.stringify(row));
   console.log(`  # tick: ${WRITER_COUNT} written at ${WRITER_RATE} Hz, ${c1 - c0} sampled and published, all received`);
   // Write-to-client latency of each new value (same host, same clock), for the docs.
   const firsts = new Map();
-  for (const m of probe.received("/ccomm/tick")) if (m.msg.seq > seq0 && !firsts.has(m.msg.seq)) firsts.set(m.msg.seq, m);
+  for (const m of probe.received("tick")) if (m.msg.seq > seq0 && !firsts.has(m.msg.seq)) firsts.set(m.msg.seq, m);
   const lat = [...firsts.values()].map((m) => Number(m.mono - BigInt(m.msg.source_time_ns)) / 1e6).sort((a, b) => a - b);
   const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))].toFixed(2);
   console.log(`  # write -> protocol client latency (ms): min ${q(0)} p50 ${q(0.5)} p99 ${q(0.99)} max ${q(1)} (n=${lat.length})`);
@@ -237,7 +248,7 @@ await check("the protocol client lost nothing while the browser died (every new 
   const f = JSON.parse(floorOut);
   console.log(`  # floor, a libccomm reader of the same values (ms): p50 ${f.p50_ms} p99 ${f.p99_ms} (n=${f.n}); ` +
               `ccomm-web p50 / floor p50 = ${(Number(q(0.5)) / f.p50_ms).toFixed(1)}`);
-  const events = probe.received("/ccomm/mode_request").map((m) => m.msg.value);
+  const events = probe.received("mode_request").map((m) => m.msg.value);
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
   assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));

@@ -18,8 +18,9 @@ Serves two things until stopped (Ctrl-C, SIGTERM):
                            assets installed at build time, see --assets)
   ws://HOST:PORT           a Foxglove WebSocket server: in Foxglove or Lichtblick, open a
                            connection "Foxglove WebSocket" to this address; one JSON
-                           channel per signal, /ccomm/SIGNAL, with fields value, seq,
-                           source_time_ns, age_ns, status, lost (plot /ccomm/SIGNAL.value)
+                           channel per signal, topic SIGNAL, fields as `ccomm record`
+                           writes them (value, seq, status, lost, gap, ...) plus age_ns:
+                           plot SIGNAL.value
 """
 
 EPILOG = """\

@@ -1,9 +1,16 @@
 # SPDX-License-Identifier: Apache-2.0
 """Samples a node's signals into JSON messages, one channel per signal.
 
-A message is what a read says: value, seq, source_time_ns, age_ns, status
-("fresh"/"stale"/"never") and lost, the convention `ccomm record` uses too, so
-Foxglove plots `/ccomm/SIGNAL.value` and shows freshness next to it.
+Topics, schema names and fields follow `ccomm record` (ccomm.mcap_io.schema), so a
+Foxglove layout made for a recording works live too (plot `SIGNAL.value`):
+
+    {"value": 1.5, "seq": 812, "source_time_ns": ..., "receive_time_ns": ...,
+     "age_ns": 1200, "status": "fresh", "fresh": true, "safe_value": false,
+     "lost": 0, "gap": 0}
+
+Live only: `age_ns` (at the read), status "never" (nothing received yet; value 0, times
+null). `gap` counts the values this view did not see between two of its messages: a
+signal written faster than the sampling is sampled (`lost` is ccomm's loss counter).
 
 A state signal is published when its sequence number or status changes, and at least
 every `keepalive` seconds (its age and a stale transition stay visible without writes).
@@ -18,54 +25,60 @@ import numpy as np
 
 from ..client import Client, Reading, Signal, SignalInfo, SignalType, Status
 
-TOPIC_PREFIX = "/ccomm/"
-
 _STATUS_NAMES = {Status.FRESH: "fresh", Status.STALE: "stale", Status.NEVER: "never"}
 
-_VALUE_SCHEMAS: Dict[SignalType, Dict[str, Any]] = {
-    SignalType.BOOL: {"type": "boolean"},
-    SignalType.INT32: {"type": "integer"},
-    SignalType.UINT32: {"type": "integer"},
-    SignalType.INT64: {"type": "integer"},
-    SignalType.FLOAT: {"type": "number"},
-    SignalType.DOUBLE: {"type": "number"},
+_JSON_TYPES: Dict[SignalType, str] = {
+    SignalType.BOOL: "boolean", SignalType.INT32: "integer", SignalType.UINT32: "integer",
+    SignalType.INT64: "integer", SignalType.FLOAT: "number", SignalType.DOUBLE: "number",
 }
 
 
 def topic_of(name: str) -> str:
-    return TOPIC_PREFIX + name
+    """The channel of a signal: its name, as in a recording."""
+    return name
 
 
 def json_schema(info: SignalInfo) -> Dict[str, Any]:
     """JSON schema of the messages of one signal's channel."""
-    value: Dict[str, Any] = dict(_VALUE_SCHEMAS[info.type])
+    value: Dict[str, Any] = {"type": [_JSON_TYPES[info.type], "null"]}
     if info.count != 1:
         value = {"type": "array", "items": value, "minItems": info.count, "maxItems": info.count}
+    integer, nullable = {"type": "integer"}, {"type": ["integer", "null"]}
     return {
         "title": "ccomm." + info.type.name.lower() + ("[%d]" % info.count if info.count != 1 else ""),
         "type": "object",
         "properties": {
             "value": value,
-            "seq": {"type": "integer", "description": "producer's sequence number, 0 = never written"},
-            "source_time_ns": {"type": "integer", "description": "producer's CLOCK_MONOTONIC at the write"},
-            "age_ns": {"type": ["integer", "null"], "description": "since the value reached this node"},
+            "seq": dict(integer, description="producer's sequence number of the value, 0 = never"),
+            "source_time_ns": dict(nullable, description="producer's CLOCK_MONOTONIC at the write"),
+            "receive_time_ns": dict(nullable, description="this node's CLOCK_MONOTONIC at arrival"),
+            "age_ns": dict(nullable, description="since the value reached this node, at the read"),
             "status": {"type": "string", "enum": ["fresh", "stale", "never"]},
-            "lost": {"type": "integer", "description": "values/events of this signal known lost"},
+            "fresh": {"type": "boolean"},
+            "safe_value": {"type": "boolean", "description": "value is the configured safe value"},
+            "lost": dict(integer, description="values known lost before this one (cumulative)"),
+            "gap": dict(integer, description="values this view did not see just before this one"),
         },
-        "required": ["value", "seq", "source_time_ns", "age_ns", "status", "lost"],
+        "required": ["value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status", "fresh",
+                     "safe_value", "lost", "gap"],
     }
 
 
-def message_of(reading: Reading) -> Dict[str, Any]:
-    """The JSON message of one read (not EMPTY). NaN and infinities become null: JSON has
-    no spelling for them."""
+def message_of(reading: Reading, now_ns: int, gap: int = 0) -> Dict[str, Any]:
+    """The JSON message of one read (not EMPTY) made at CLOCK_MONOTONIC `now_ns`. NaN and
+    infinities become null: JSON has no spelling for them."""
     value: Any = reading.value
     if isinstance(value, np.ndarray):
         value = [_finite(v) for v in value.tolist()]
     else:
         value = _finite(value)
-    return {"value": value, "seq": reading.seq, "source_time_ns": reading.source_time_ns,
-            "age_ns": reading.age_ns, "status": _STATUS_NAMES[reading.status], "lost": reading.lost}
+    never = reading.status == Status.NEVER
+    return {"value": value, "seq": reading.seq,
+            "source_time_ns": None if never else reading.source_time_ns,
+            "receive_time_ns": None if reading.age_ns is None else now_ns - reading.age_ns,
+            "age_ns": reading.age_ns, "status": _STATUS_NAMES[reading.status],
+            "fresh": reading.status == Status.FRESH, "safe_value": reading.safe_value,
+            "lost": reading.lost, "gap": gap}
 
 
 def _finite(v: Any) -> Any:
@@ -82,6 +95,7 @@ class _Tracked:
     last_sent: float = 0.0
     published: int = 0
     changes: int = 0  #: messages with a new seq (a new value or event), keepalives not counted
+    gaps: int = 0  #: values not seen between two messages (sum of their gap fields)
 
 
 @dataclass
@@ -94,6 +108,7 @@ class Sampler:
     publish: Callable[[str, Dict[str, Any]], None]
     keepalive: float = 1.0
     _tracked: List[_Tracked] = field(default_factory=list)
+    _now_ns: int = 0
 
     def __post_init__(self) -> None:
         self._tracked = [_Tracked(self.client.signal(n)) for n in self.names]
@@ -106,9 +121,14 @@ class Sampler:
     def changes(self) -> Dict[str, int]:
         return {t.signal.name: t.changes for t in self._tracked}
 
+    @property
+    def gaps(self) -> Dict[str, int]:
+        return {t.signal.name: t.gaps for t in self._tracked}
+
     def poll(self, now: Optional[float] = None) -> int:
         """One pass over every signal; returns how many messages were published."""
         now = time.monotonic() if now is None else now
+        self._now_ns = self.client.now()  # receive times: one clock reading per pass
         sent = 0
         for t in self._tracked:
             if t.signal.info.is_event:
@@ -129,6 +149,8 @@ class Sampler:
     def _send(self, t: _Tracked, r: Reading, now: float) -> None:
         if r.seq != t.last_seq or t.signal.info.is_event:
             t.changes += 1
+        gap = r.seq - t.last_seq - 1 if t.last_seq > 0 and r.seq > t.last_seq + 1 else 0
+        t.gaps += gap
         t.last_seq, t.last_status, t.last_sent = r.seq, r.status, now
         t.published += 1
-        self.publish(t.signal.name, message_of(r))
+        self.publish(t.signal.name, message_of(r, self._now_ns, gap))

@@ -113,6 +113,7 @@ class LiveServer:
         self.stop_event = threading.Event()
         self.published: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.changes: Dict[str, int] = {i.name: 0 for i in self.infos}
+        self.gaps: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.sampler_error: Optional[str] = None
         self.daemon_alive: Optional[bool] = None
         self._threads = [threading.Thread(target=self.http.serve_forever, name="http", daemon=True),
@@ -150,7 +151,7 @@ class LiveServer:
             try:
                 with Client(self.node) as client:
                     sampler = Sampler(client, [i.name for i in self.infos], self._publish, self.keepalive)
-                    base, base_changes = dict(self.published), dict(self.changes)
+                    base, base_changes, base_gaps = dict(self.published), dict(self.changes), dict(self.gaps)
                     while not self.stop_event.is_set():
                         started = time.monotonic()
                         client.wait(timeout=0.1)
@@ -160,6 +161,8 @@ class LiveServer:
                             self.published[name] = base[name] + n
                         for name, n in sampler.changes.items():
                             self.changes[name] = base_changes[name] + n
+                        for name, n in sampler.gaps.items():
+                            self.gaps[name] = base_gaps[name] + n
                         self.ws.broadcast_time(time.time_ns())
                         rest = min_period - (time.monotonic() - started)
                         if rest > 0:
@@ -195,6 +198,7 @@ class LiveServer:
 
     def stats(self) -> Dict[str, Any]:
         s: Dict[str, Any] = {"published": dict(self.published), "changes": dict(self.changes),
+                             "gaps": dict(self.gaps),
                              "sampler_error": self.sampler_error, "daemon_alive": self.daemon_alive}
         s.update(self.subs.snapshot())
         return s

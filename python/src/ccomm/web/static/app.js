@@ -57,7 +57,7 @@ function buildTable(cfg) {
     const type = s.type + (s.count !== 1 ? "[" + s.count + "]" : "") + (s.event ? " event" : "");
     tr.innerHTML = '<td><input type="checkbox"></td><td class="name"></td><td class="type"></td>' +
       '<td><span class="badge never status">never</span></td><td class="value num">–</td>' +
-      '<td class="seq num">–</td><td class="age num">–</td><td class="lost num">0</td><td class="msgs num">0</td>';
+      '<td class="seq num">–</td><td class="age num">–</td><td class="lost num">0</td><td class="skipped num">0</td><td class="msgs num">0</td>';
     tr.querySelector(".name").textContent = s.name;
     tr.querySelector(".type").textContent = type;
     const box = tr.querySelector("input");
@@ -67,7 +67,7 @@ function buildTable(cfg) {
       buildCharts();
     });
     body.appendChild(tr);
-    view.rows[s.name] = { tr, signal: s, last: null, lastAt: 0, msgs: 0 };
+    view.rows[s.name] = { tr, signal: s, last: null, lastAt: 0, msgs: 0, skipped: 0 };
   }
 }
 
@@ -86,6 +86,7 @@ function updateRow(row) {
   const lost = tr.querySelector(".lost");
   lost.textContent = String(m.lost);
   lost.classList.toggle("nonzero", m.lost > 0);
+  tr.querySelector(".skipped").textContent = String(row.skipped);
   tr.querySelector(".msgs").textContent = String(row.msgs);
 }
 
@@ -177,6 +178,7 @@ let ws = null, retryMs = 500;
 const channels = new Map();      // channel id -> signal name
 const subscriptions = new Map(); // subscription id -> signal name
 let nextSubId = 1;
+const topicToName = new Map();   // filled from /config.json
 const statuses = new Map();      // the server's warnings by id (e.g. ccommd stopped)
 
 function connect() {
@@ -202,8 +204,8 @@ function onText(text) {
   if (msg.op === "advertise") {
     const subs = [];
     for (const ch of msg.channels) {
-      const name = ch.topic.startsWith("/ccomm/") ? ch.topic.slice(7) : null;
-      if (!name || !view.rows[name] || ch.encoding !== "json") continue;
+      const name = topicToName.get(ch.topic);
+      if (!name || ch.encoding !== "json") continue;
       channels.set(ch.id, name);
       const id = nextSubId++;
       subscriptions.set(id, name);
@@ -241,6 +243,7 @@ function onBinary(buf) {
   row.last = m;
   row.lastAt = performance.now();
   row.msgs++;
+  row.skipped += m.gap || 0;
   view.received++;
   if (m.status !== "never") addPoint(name, t, m.value, m.status);
   row.dirtyRow = true;
@@ -263,6 +266,7 @@ async function start() {
     return;
   }
   $("#node").textContent = "node " + view.config.node;
+  for (const sig of view.config.signals) topicToName.set(sig.topic, sig.name);
   const chosen = params.get("plot");
   for (const n of chosen !== null ? chosen.split(",").filter(Boolean) : view.config.plot) view.plot.add(n);
   buildTable(view.config);

@@ -1,0 +1,105 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ccomm.web.sampler against a real ccommd (tests/web/run starts one for node `viewer` of
+web.xml under its own CCOMM_SHM_PREFIX): what is published when, and what it looks like."""
+import math
+import time
+
+import numpy as np
+import pytest
+
+import ccomm
+from ccomm.web.sampler import Sampler, json_schema, message_of, topic_of
+
+NODE = "viewer"
+
+
+@pytest.fixture
+def client():
+    with ccomm.Client(NODE) as c:
+        yield c
+
+
+def sampler(client, names, keepalive=1.0):
+    sent = []
+    return Sampler(client, names, lambda name, msg: sent.append((name, msg)), keepalive), sent
+
+
+def test_schema_per_type(client):
+    infos = {i.name: i for i in client.signals()}
+    assert json_schema(infos["wheel_pos"])["properties"]["value"] == {"type": ["number", "null"]}
+    assert json_schema(infos["tick"])["properties"]["value"] == {"type": ["integer", "null"]}
+    assert json_schema(infos["drive_ok"])["properties"]["value"] == {"type": ["boolean", "null"]}
+    joint = json_schema(infos["joint_pos"])
+    assert joint["properties"]["value"]["items"] == {"type": ["number", "null"]}
+    assert joint["properties"]["value"]["maxItems"] == 3 and joint["title"] == "ccomm.double[3]"
+    # the fields of a `ccomm record` recording, plus age_ns
+    assert set(joint["required"]) == {"value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status",
+                                      "fresh", "safe_value", "lost", "gap"}
+    assert topic_of("tick") == "tick"
+
+
+def test_message_fields_and_non_finite_values(client):
+    before = client.now()
+    client.write("joint_pos", [1.5, math.nan, -math.inf])
+    r = client.read("joint_pos")
+    now = client.now()
+    m = message_of(r, now)
+    assert m["value"] == [1.5, None, None] and m["status"] == "fresh" and m["fresh"] and m["seq"] >= 1
+    assert 0 <= m["age_ns"] < 5e9 and m["lost"] == 0 and m["gap"] == 0 and not m["safe_value"]
+    assert before <= m["receive_time_ns"] <= now and before <= m["source_time_ns"] <= now
+    client.write("wheel_pos", math.nan)
+    assert message_of(client.read("wheel_pos"), now)["value"] is None
+    never = message_of(client.read("unused_sp"), now)
+    assert never == {"value": 0.0, "seq": 0, "source_time_ns": None, "receive_time_ns": None, "age_ns": None,
+                     "status": "never", "fresh": False, "safe_value": True, "lost": 0, "gap": 0}  # safe_value="0"
+
+
+def test_publishes_changes_only_then_keepalive(client):
+    s, sent = sampler(client, ["tick", "drive_ok"], keepalive=5.0)
+    t0 = time.monotonic()
+    assert s.poll(t0) == 2  # first pass: everything once
+    sent.clear()
+    assert s.poll(t0 + 0.1) == 0  # nothing changed
+    client.write("tick", 7)
+    assert s.poll(t0 + 0.2) == 1 and sent[0][0] == "tick" and sent[0][1]["value"] == 7
+    assert s.poll(t0 + 5.3) == 2  # keepalive: both again, unchanged
+    assert s.changes["tick"] == 2 and s.published["tick"] == 3
+
+
+def test_gap_counts_values_written_between_two_passes(client):
+    s, sent = sampler(client, ["tick"])
+    client.write("tick", 1)
+    s.poll()
+    for v in (2, 3, 4):
+        client.write("tick", v)
+    s.poll()
+    assert sent[-1][1]["value"] == 4 and sent[-1][1]["gap"] == 2 and s.gaps["tick"] == 2
+
+
+def test_going_stale_is_published_without_a_write(client):
+    s, sent = sampler(client, ["wheel_pos"], keepalive=60.0)  # stale_after_ms=300
+    client.write("wheel_pos", 0.5)
+    s.poll()
+    assert sent[-1][1]["status"] == "fresh"
+    time.sleep(0.4)
+    assert s.poll() == 1
+    assert sent[-1][1]["status"] == "stale" and sent[-1][1]["value"] == 0.5
+    assert s.changes["wheel_pos"] == 1  # a status change, not a new value
+
+
+def test_every_event_once_in_order(client):
+    s, sent = sampler(client, ["mode_request"])
+    s.poll()
+    sent.clear()
+    for v in (3, 1, 4):
+        client.write("mode_request", v)
+    assert s.poll() == 3
+    assert [m["value"] for _, m in sent] == [3, 1, 4]
+    assert s.poll() == 0  # EMPTY: nothing republished for events
+
+
+def test_arrays_come_as_lists(client):
+    s, sent = sampler(client, ["joint_pos"])
+    client.write("joint_pos", np.array([0.25, -1.0, 2.0]))
+    s.poll()
+    assert sent[-1][1]["value"] == [0.25, -1.0, 2.0]

@@ -100,19 +100,19 @@ def fetch_rt_patches(cache, version):
                   + (f" (and {len(tried) - 3} more)" if len(tried) > 3 else ""))
 
 
-def rt_tree(cache, plain, deb_version, allow_fetch):
+def rt_tree(cache, plain, deb_version, use_patches):
     """A copy of the plain tree with Debian's patches-rt applied: hard links, which GNU patch
     replaces rather than edits, so the plain tree stays as it is. Returns (tree, note) or
     (None, reason)."""
     dest = os.path.join(cache, "src-rt")
     stamp = os.path.join(cache, "src-rt.patched")
     origin = open(os.path.join(cache, "src", ".ccomm-extracted")).read()
+    if not use_patches:
+        return None, "--no-rt-patches given"
     if os.path.isfile(stamp) and os.path.isdir(dest):
         key, _, note = open(stamp).read().partition("\n")
         if key + "\n" == origin:
             return tree_dir(dest), note.strip()
-    if not allow_fetch:
-        return None, "--no-rt-fetch: Debian's PREEMPT_RT patches were not fetched"
     series_dir, used = fetch_rt_patches(cache, deb_version)
     if series_dir is None:
         return None, used

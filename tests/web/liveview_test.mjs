@@ -213,6 +213,7 @@ await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page
     sock.on("end", () => res(out.split("\r\n")[0]));
     sock.on("error", rej);
   });
+  const refused0 = (await stats()).http_refused;
   for (const path of ["/../../etc/passwd", "/%2e%2e/server.py", "/static/app.js", "/vendor/../cli.py", "/server.py"]) {
     const status = await raw(`GET ${path} HTTP/1.0\r\n\r\n`);
     assert(status.includes(" 404 "), path + ": " + status);
@@ -220,6 +221,8 @@ await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page
   assert((await raw("JUNK\r\n\r\n")).includes(" 400 "), "junk request");
   assert((await raw("POST / HTTP/1.0\r\nContent-Length: 0\r\n\r\n")).includes(" 501 "), "POST");
   assert((await raw("GET /app.js HTTP/1.0\r\n\r\n")).includes(" 200 "), "/app.js");
+  const refused = (await stats()).http_refused - refused0;
+  assert(refused === 7, "refused requests counted: " + refused + " of 7");
 });
 
 await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {

@@ -116,6 +116,8 @@ class LiveServer:
         self.gaps: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.sampler_error: Optional[str] = None
         self.daemon_alive: Optional[bool] = None
+        self.http_refused = 0
+        self.counter_lock = threading.Lock()
         self._threads = [threading.Thread(target=self.http.serve_forever, name="http", daemon=True),
                          threading.Thread(target=self._sample_loop, name="sampler", daemon=True)]
 
@@ -199,6 +201,7 @@ class LiveServer:
     def stats(self) -> Dict[str, Any]:
         s: Dict[str, Any] = {"published": dict(self.published), "changes": dict(self.changes),
                              "gaps": dict(self.gaps),
+                             "http_refused": self.http_refused,
                              "sampler_error": self.sampler_error, "daemon_alive": self.daemon_alive}
         s.update(self.subs.snapshot())
         return s
@@ -211,7 +214,12 @@ def _handler(server: LiveServer) -> type:
         server_version = "ccomm-web"
 
         def log_message(self, format: str, *args: Any) -> None:  # noqa: A002
-            pass  # one line per request would drown the start-up lines; errors go to the page
+            pass  # one line per request would drown the start-up lines; refusals are counted
+
+        def send_error(self, code: int, message: Optional[str] = None, explain: Optional[str] = None) -> None:
+            with server.counter_lock:  # every refused request (400, 404, 501...), in /stats.json
+                server.http_refused += 1
+            super().send_error(code, message, explain)
 
         def do_HEAD(self) -> None:
             self.do_GET(body=False)

@@ -81,9 +81,10 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
       const ccomm_signal_stats& ss = now.sigs[i];
       printf("%s{\"name\":\"%s\",\"writes\":%" PRIu64 ",\"write_errors\":%" PRIu64 ",\"tx\":%" PRIu64
              ",\"rx\":%" PRIu64 ",\"lost\":%" PRIu64 ",\"coalesced\":%" PRIu64 ",\"overflow\":%" PRIu64
-             ",\"stale_transitions\":%" PRIu64 ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
+             ",\"stale_transitions\":%" PRIu64 ",\"corrupt\":%" PRIu64
+             ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
              i ? "," : "", now.descs[i].name, ss.writes, ss.write_errors, ss.tx, ss.rx, ss.lost, ss.coalesced,
-             ss.overflow, ss.stale_transitions, ss.stale ? "true" : "false",
+             ss.overflow, ss.stale_transitions, ss.corrupt, ss.stale ? "true" : "false",
              before ? Rate(before->sigs[i].rx, ss.rx, secs) : 0.0, before ? Rate(before->sigs[i].tx, ss.tx, secs) : 0.0);
     }
     printf("]}\n");

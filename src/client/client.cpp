@@ -172,7 +172,10 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   const uint32_t n = c->signal_count;
   c->sig = new (std::nothrow) HandleSignal[n ? n : 1];
   size_t cache_total = 0;
-  for (uint32_t i = 0; i < n; ++i) cache_total += CachedBytes(c->segment.dir(i));
+  for (uint32_t i = 0; i < n; ++i) {
+    cache_total += CachedBytes(c->segment.dir(i));
+    if (c->segment.safe_value(i)) cache_total += c->segment.dir(i).value_bytes;  // a private copy
+  }
   c->cache_bytes = new (std::nothrow) uint8_t[cache_total ? cache_total : 1];
   c->pending_dirty = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
   if (!c->sig || !c->cache_bytes || !c->pending_dirty) {
@@ -189,7 +192,12 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
     h.type = d.type;
     h.stale_ns = uint64_t{d.stale_after_ms} * 1000000;
     h.stats = &c->segment.stats(i);
-    h.safe_value = c->segment.safe_value(i);
+    if (const uint8_t* safe = c->segment.safe_value(i)) {
+      // Copied at open: the segment is writable by every client, the safe value is not.
+      memcpy(c->cache_bytes + off, safe, d.value_bytes);
+      h.safe_value = c->cache_bytes + off;
+      off += d.value_bytes;
+    }
     if (d.flags & st::kSigEvent) {
       h.ring = c->segment.ring(i);
       ccomm::store::RingSubscribe(h.ring, &h.cursor);
@@ -231,6 +239,7 @@ const char* ccomm_strerror(int code) {
     case CCOMM_E_SYS: return "operating system error (see errno)";
     case CCOMM_E_VERSION: return "shared-memory layout version differs from this library";
     case CCOMM_E_RETIRED: return "segment replaced by a new configuration; reopen";
+    case CCOMM_E_CORRUPT: return "value in shared memory failed its check (segment written over); not returned";
     default: return "unknown code";
   }
 }
@@ -272,6 +281,10 @@ int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_i
     RingCursor& cur = h->cursor;
     uint64_t lost_before = cur.lost;
     StoreResult r = ccomm::store::RingRead(h->ring, &cur, value, &meta, now);
+    if (r == StoreResult::kCorrupt) {  // skipped (counted lost for this handle), never returned
+      h->stats->corrupt.fetch_add(1, std::memory_order_relaxed);
+      return CCOMM_E_CORRUPT;
+    }
     if (cur.lost != lost_before) h->stats->overflow.fetch_add(cur.lost - lost_before, std::memory_order_relaxed);
     if (r != StoreResult::kOk) {
       if (info) {
@@ -294,6 +307,10 @@ int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_i
 
   StoreResult r = ReadState(*h, value, &meta);
   if (r == StoreResult::kBusy) return CCOMM_E_BUSY;
+  if (r == StoreResult::kCorrupt) {
+    h->stats->corrupt.fetch_add(1, std::memory_order_relaxed);
+    return CCOMM_E_CORRUPT;
+  }
   int status;
   int64_t age = -1;
   if (r == StoreResult::kNever) {
@@ -464,6 +481,7 @@ int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_s
   out->lost = ss.lost.load(std::memory_order_relaxed);
   out->overflow = ss.overflow.load(std::memory_order_relaxed);
   out->stale_transitions = ss.stale_transitions.load(std::memory_order_relaxed);
+  out->corrupt = ss.corrupt.load(std::memory_order_relaxed);
   const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
   const uint64_t now = ccomm::platform::MonotonicNs();
   out->last_rx_age_ns = last ? Age(now, last) : -1;
@@ -479,7 +497,7 @@ int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out)
   const uint32_t n = static_cast<uint32_t>(node);
   const st::PeerStats& ps = c->segment.peer(n);
   out->name = c->segment.node_name(n);
-  out->is_self = n == c->segment.header()->node_id;
+  out->is_self = n == c->segment.node_id();
   out->alive = ps.alive.load(std::memory_order_relaxed) ? 1 : 0;
   out->frames_rx = ps.frames_rx.load(std::memory_order_relaxed);
   out->frames_tx = ps.frames_tx.load(std::memory_order_relaxed);

@@ -65,7 +65,12 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
     store::RingView ring = segment_.ring(id);
     store::RingCursor& cur = fwd_cursors_[id];
     for (uint32_t i = 0; i < d.queue_depth; ++i) {  // bounded: at most one ring's worth
-      if (store::RingRead(ring, &cur, tx_value_, &m, now) != store::StoreResult::kOk) break;
+      const store::StoreResult r = store::RingRead(ring, &cur, tx_value_, &m, now);
+      if (r == store::StoreResult::kCorrupt) {  // damaged in shared memory: never forwarded
+        segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      if (r != store::StoreResult::kOk) break;
       AddEntry(id, d, wire::kEntryEvent, m, tx_value_, now);
     }
     store::SetRingForwardCursor(ring, cur.next);
@@ -75,7 +80,9 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
   if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
-  if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) return;
+  const store::StoreResult r = store::StateRead(sv, tx_value_, &m);
+  if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
+  if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
   uint64_t& last = last_tx_seq_[id];
   if (!periodic && last && m.value_seq > last + 1)

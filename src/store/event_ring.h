@@ -98,8 +98,9 @@ inline void RingSubscribe(const RingView& v, RingCursor* c) {
   c->stuck_since = 0;
 }
 
-/// Pops the next event for this cursor: kOk, kEmpty, or kPending (the next event is
-/// claimed but not complete; try again). `now_ns` times out holes and spaces out the
+/// Pops the next event for this cursor: kOk, kEmpty, kPending (the next event is
+/// claimed but not complete; try again) or kCorrupt (the next event failed its check:
+/// skipped and counted lost for this cursor). `now_ns` times out holes and spaces out the
 /// reader's looks at `head`; 0 = look every time.
 inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMeta* meta,
                             uint64_t now_ns) {
@@ -108,10 +109,13 @@ inline StoreResult RingRead(const RingView& v, RingCursor* c, void* out, SlotMet
     const SlotHeader* s = v.slot(t);
     uint64_t s1 = s->seq.load(std::memory_order_acquire);
     if (s1 == 2 * t + 2) {
-      if (ReadSlot(s, t, v.value_bytes, out, meta)) {
+      const CopyResult r = ReadSlot(s, t, v.value_bytes, out, meta);
+      if (r != CopyResult::kChanged) {
         c->next = t + 1;
         c->stuck_since = 0;
-        return StoreResult::kOk;
+        if (r == CopyResult::kOk) return StoreResult::kOk;
+        c->lost++;  // a damaged event is skipped (and counted by the caller), never returned
+        return StoreResult::kCorrupt;
       }
       continue;  // overwritten while copying: we were lapped; recheck below
     }

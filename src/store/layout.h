@@ -25,7 +25,7 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 3;
+constexpr uint32_t kLayoutVersion = 4;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
@@ -114,8 +114,10 @@ struct alignas(8) SlotHeader {
   std::atomic<uint64_t> value_seq;       // producer's sequence number of the value
   std::atomic<uint64_t> source_time_ns;  // producer's clock at write
   std::atomic<uint64_t> local_time_ns;   // this node's clock when it entered the segment
+  std::atomic<uint64_t> check;           // CopyCheck of meta and value (seqlock.h): a copy a
+                                         // stray client write damaged is detected, not used
 };
-static_assert(sizeof(SlotHeader) == 40, "slot header is 5 words");
+static_assert(sizeof(SlotHeader) == 48, "slot header is 6 words");
 
 // Values of at most this many bytes also live in the cell's first cache line (below).
 constexpr uint32_t kInlineValueBytes = 16;
@@ -130,7 +132,7 @@ constexpr uint32_t kInlineValueBytes = 16;
 struct alignas(kCacheLine) StateCell {
   std::atomic<uint64_t> latest;       // ticket + 1 of the newest complete copy; 0 = never
   std::atomic<uint64_t> inline_seq;   // 2t+1 while ticket t's value is copied in, 2t+2 complete
-  std::atomic<uint64_t> inline_meta[3];  // value_seq, source_time_ns, local_time_ns (as SlotHeader)
+  std::atomic<uint64_t> inline_meta[4];  // value_seq, source_time_ns, local_time_ns, check (as SlotHeader)
   std::atomic<uint64_t> inline_value[kInlineValueBytes / 8];
   alignas(kCacheLine) std::atomic<uint64_t> next_ticket;  // claimed tickets
   std::atomic<uint64_t> forwarded;    // `latest` value ccommd last sent (send-side bookkeeping)
@@ -160,6 +162,7 @@ struct alignas(kCacheLine) SignalStats {
   std::atomic<uint64_t> overflow;     // events a reader lost to ring overrun (all readers)
   std::atomic<uint64_t> stale_transitions;  // fresh -> stale seen by ccommd's supervision
   std::atomic<uint64_t> last_rx_ns;
+  std::atomic<uint64_t> corrupt;      // copies that failed their check (seqlock.h), by any reader
 };
 static_assert(sizeof(SignalStats) == 2 * kCacheLine, "writer line + receive line");
 

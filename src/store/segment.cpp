@@ -10,6 +10,7 @@
 #include <new>
 
 #include "common/platform.h"
+#include "common/value_type.h"
 
 namespace ccomm {
 namespace store {
@@ -101,8 +102,16 @@ int Segment::Open(const std::string& name) {
     platform::Unmap(p, size);
     return -ENOENT;
   }
+  if (!CheckLayout(p, size).empty()) {
+    platform::Unmap(p, size);
+    return -EPROTO;
+  }
   base_ = p;
   size_ = size;
+  if (CopyLayout(p) != 0) {
+    Close();
+    return -ENOMEM;
+  }
   return 0;
 }
 
@@ -110,6 +119,65 @@ void Segment::Close() {
   if (base_) platform::Unmap(base_, size_);
   base_ = nullptr;
   size_ = 0;
+  FreeLayout();
+}
+
+void Segment::FreeLayout() {
+  delete[] layout_.directory;
+  delete[] layout_.node_names;
+  layout_ = Layout();
+}
+
+int Segment::CopyLayout(const void* trusted) {
+  FreeLayout();
+  const auto* h = static_cast<const SegmentHeader*>(trusted);
+  layout_.signal_count = h->signal_count;
+  layout_.node_count = h->node_count;
+  layout_.node_id = h->node_id;
+  layout_.signal_stats_offset = h->signal_stats_offset;
+  layout_.peer_stats_offset = h->peer_stats_offset;
+  layout_.dirty_offset = h->dirty_offset;
+  layout_.directory = new (std::nothrow) SignalDirectoryEntry[h->signal_count ? h->signal_count : 1];
+  layout_.node_names = new (std::nothrow) char[(h->node_count ? h->node_count : 1) * kNameBytes];
+  if (!layout_.directory || !layout_.node_names) {
+    FreeLayout();
+    return -ENOMEM;
+  }
+  memcpy(static_cast<void*>(layout_.directory), At<char>(trusted, h->directory_offset),
+         h->signal_count * sizeof(SignalDirectoryEntry));
+  memcpy(layout_.node_names, At<char>(trusted, h->node_names_offset), h->node_count * kNameBytes);
+  for (uint32_t i = 0; i < h->signal_count; ++i) layout_.directory[i].name[kNameBytes - 1] = '\0';
+  for (uint32_t i = 0; i < h->node_count; ++i) layout_.node_names[i * kNameBytes + kNameBytes - 1] = '\0';
+  return 0;
+}
+
+std::string CheckLayout(const void* base, size_t size) {
+  const auto* h = static_cast<const SegmentHeader*>(base);
+  auto within = [size](uint64_t off, uint64_t bytes) { return off <= size && bytes <= size - off; };
+  const uint64_t n = h->signal_count, m = h->node_count;
+  if (n > 65536 || m == 0 || m > 65536 || h->node_id >= m) return "signal/node counts out of range";
+  if (!within(h->directory_offset, n * sizeof(SignalDirectoryEntry)) || !within(h->node_names_offset, m * kNameBytes) ||
+      !within(h->signal_stats_offset, n * sizeof(SignalStats)) || !within(h->peer_stats_offset, m * sizeof(PeerStats)) ||
+      !within(h->dirty_offset, (n + 63) / 64 * 8) || h->signal_stats_offset % kCacheLine ||
+      h->peer_stats_offset % kCacheLine || h->dirty_offset % 8)
+    return "a table lies outside the segment";
+  for (uint64_t i = 0; i < n; ++i) {
+    const SignalDirectoryEntry& d = At<SignalDirectoryEntry>(base, h->directory_offset)[i];
+    const bool event = (d.flags & kSigEvent) != 0;
+    const size_t esize = ValueTypeSize(d.type);
+    if (esize == 0 || d.count == 0 || d.value_bytes != d.count * esize || d.value_bytes > (1u << 20) ||
+        d.slot_bytes < sizeof(SlotHeader) + d.value_bytes || d.slot_bytes % 8 || d.data_offset % kCacheLine)
+      return "signal " + std::to_string(i) + ": bad type, size or slot";
+    const uint64_t depth = event ? d.queue_depth : kStateSlots;
+    if (depth == 0 || (event && (depth & (depth - 1))) || (!event && d.queue_depth != kStateSlots))
+      return "signal " + std::to_string(i) + ": bad queue depth";
+    const uint64_t head = event ? sizeof(EventRing) : sizeof(StateCell);
+    if (!within(d.data_offset, head + depth * d.slot_bytes))
+      return "signal " + std::to_string(i) + ": data outside the segment";
+    if (d.safe_value_offset && !within(d.safe_value_offset, d.value_bytes))
+      return "signal " + std::to_string(i) + ": safe value outside the segment";
+  }
+  return "";
 }
 
 // Compares the immutable part (header identity, directory, names, safe values) of an
@@ -145,6 +213,10 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
     base_ = old.base_;
     size_ = old.size_;
     old.base_ = nullptr;
+    if (CopyLayout(plan) != 0) {
+      Close();
+      return -ENOMEM;
+    }
     header()->generation.fetch_add(1, std::memory_order_acq_rel);
     *adopted = true;
     return 0;
@@ -174,6 +246,11 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
   memcpy(p, plan, size);
   base_ = p;
   size_ = size;
+  if (CopyLayout(plan) != 0) {
+    Close();
+    platform::ShmUnlink(name.c_str());
+    return -ENOMEM;
+  }
   header()->generation.store(1, std::memory_order_relaxed);
   header()->state.store(kReady, std::memory_order_release);
   return 0;

@@ -40,24 +40,18 @@ class Segment {
   void Close();
   bool is_open() const { return base_ != nullptr; }
 
+  // The layout (counts, offsets, directory, node names) is copied into this process
+  // when the segment is created or opened (and checked then): clients can write over
+  // the whole mapping, and nobody may follow an offset or index read from it afterwards.
   SegmentHeader* header() const { return static_cast<SegmentHeader*>(base_); }
-  uint32_t signal_count() const { return header()->signal_count; }
-  uint32_t node_count() const { return header()->node_count; }
-  const SignalDirectoryEntry& dir(uint32_t id) const {
-    return At<SignalDirectoryEntry>(base_, header()->directory_offset)[id];
-  }
-  const char* node_name(uint32_t node) const {
-    return At<char>(base_, header()->node_names_offset) + node * kNameBytes;
-  }
-  SignalStats& stats(uint32_t id) const {
-    return At<SignalStats>(base_, header()->signal_stats_offset)[id];
-  }
-  PeerStats& peer(uint32_t node) const {
-    return At<PeerStats>(base_, header()->peer_stats_offset)[node];
-  }
-  std::atomic<uint64_t>* dirty_words() const {
-    return At<std::atomic<uint64_t>>(base_, header()->dirty_offset);
-  }
+  uint32_t signal_count() const { return layout_.signal_count; }
+  uint32_t node_count() const { return layout_.node_count; }
+  uint32_t node_id() const { return layout_.node_id; }
+  const SignalDirectoryEntry& dir(uint32_t id) const { return layout_.directory[id]; }
+  const char* node_name(uint32_t node) const { return layout_.node_names + node * kNameBytes; }
+  SignalStats& stats(uint32_t id) const { return At<SignalStats>(base_, layout_.signal_stats_offset)[id]; }
+  PeerStats& peer(uint32_t node) const { return At<PeerStats>(base_, layout_.peer_stats_offset)[node]; }
+  std::atomic<uint64_t>* dirty_words() const { return At<std::atomic<uint64_t>>(base_, layout_.dirty_offset); }
   StateView state(uint32_t id) const;
   RingView ring(uint32_t id) const;
   const uint8_t* safe_value(uint32_t id) const;
@@ -84,9 +78,27 @@ class Segment {
   size_t size() const { return size_; }
 
  private:
+  // A private copy of what only ccommd may change (see above).
+  struct Layout {
+    uint32_t signal_count = 0, node_count = 0, node_id = 0;
+    uint64_t signal_stats_offset = 0, peer_stats_offset = 0, dirty_offset = 0;
+    SignalDirectoryEntry* directory = nullptr;
+    char* node_names = nullptr;
+  };
+  /// Copies the layout of `trusted` (the daemon's own image, or a mapping that passed
+  /// CheckLayout) into layout_; -ENOMEM on failure.
+  int CopyLayout(const void* trusted);
+  void FreeLayout();
+
   void* base_ = nullptr;
   size_t size_ = 0;
+  Layout layout_;
 };
+
+/// Checks that every offset and size in a mapped segment's header and directory stays
+/// inside its `size` bytes and is consistent (a damaged or foreign segment is refused at
+/// open instead of being followed). Returns "" or what is wrong.
+std::string CheckLayout(const void* base, size_t size);
 
 }  // namespace store
 }  // namespace ccomm

@@ -57,6 +57,31 @@ TEST_F(SegmentTest, CreateThenOpenSeesDirectory) {
   EXPECT_EQ(c.safe_value(1), nullptr);
 }
 
+// Clients can write over the whole mapping: whoever mapped the segment before keeps its
+// private layout (nothing it follows changes), and whoever opens it afterwards refuses a
+// layout that points outside the segment instead of following it.
+TEST_F(SegmentTest, LayoutWrittenOverIsNeitherFollowedNorAccepted) {
+  SystemConfig cfg = Cfg();
+  Segment d;
+  bool adopted = true;
+  std::string err;
+  ASSERT_EQ(CreateOrAdoptSegment(&d, cfg, 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+  Segment before;
+  ASSERT_EQ(before.Open(SegmentName("a")), 0);
+  const uint64_t data0 = d.dir(0).data_offset;
+  auto* dir = At<SignalDirectoryEntry>(d.base(), d.header()->directory_offset);
+  dir[0].data_offset = uint64_t{1} << 40;  // a stray write
+  d.header()->signal_stats_offset = ~uint64_t{0};
+  EXPECT_EQ(d.dir(0).data_offset, data0);
+  EXPECT_EQ(before.dir(0).data_offset, data0);
+  double v = 1.5;
+  EXPECT_EQ(StateWrite(before.state(0), &v, 0, 1, 1), StoreResult::kOk);  // still the real cell
+  before.stats(0).writes.fetch_add(1);
+  Segment after;
+  EXPECT_EQ(after.Open(SegmentName("a")), -EPROTO);
+  EXPECT_NE(CheckLayout(d.base(), d.size()), "");
+}
+
 TEST_F(SegmentTest, RestartAdoptsAndKeepsValues) {
   SystemConfig cfg = Cfg();
   std::string err;
@@ -185,9 +210,8 @@ TEST_F(SegmentTest, ReclaimPublishesADeadInlineWritersValue) {
     uint64_t t = v.cell->next_ticket.fetch_add(1);
     double y = 2.0;
     SlotHeader* h = v.slot(t);
-    h->seq.store(2 * t + 1);
-    StoreWords(reinterpret_cast<uint8_t*>(h + 1), &y, 8);
-    h->seq.store(2 * t + 2);
+    ASSERT_TRUE(ClaimCopy(h, t));
+    PublishSlot(h, t, 8, &y, SlotMeta{t + 1, 2, 2});
     ASSERT_TRUE(ClaimInline(v, t));
     FillInline(v, t, SlotMeta{t + 1, 2, 2}, &y);
     _exit(0);

@@ -4,9 +4,13 @@
 // inline copies all hold a value this way; state_slot.h and event_ring.h decide which
 // ticket goes where, this file is how one copy is written and read.
 //
-// A copy is a sequence word, three meta words (value_seq, source time, local time) and
-// the value, padded to 8 bytes. Sequence word for ticket t: 2t+1 while being written,
-// 2t+2 when complete. Invariants:
+// A copy is a sequence word, four meta words (value_seq, source time, local time, check)
+// and the value, padded to 8 bytes. Sequence word for ticket t: 2t+1 while being written,
+// 2t+2 when complete. `check` is a hash of the other meta words and the value: shared
+// memory is writable by every client of the node, and a stray write (a buggy model's
+// pointer) that leaves the sequence word plausible must not turn into a value readers
+// take as fresh. It detects damage, not forgery: a client that writes a plausible value
+// with its check is a producer, trusted by design (docs/reliability.md). Invariants:
 //   - A copy is claimed only from an even sequence word not newer than 2t (a CAS), so
 //     two writers never fill one copy and a copy never goes back to an older ticket.
 //   - A reader accepts a copy only if the sequence word is 2t+2 before and after
@@ -15,6 +19,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <cstring>
 
 #include "common/platform.h"
 #include "store/layout.h"
@@ -28,6 +33,36 @@ struct SlotMeta {
   uint64_t source_time_ns = 0;
   uint64_t local_time_ns = 0;
 };
+
+/// The check of one copy (splitmix64 steps over meta and value words, zero-padded tail).
+inline uint64_t CopyCheck(const SlotMeta& meta, const void* value, uint32_t value_bytes) {
+  auto mix = [](uint64_t x) {
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ull;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+  };
+  uint64_t h = mix(0x9e3779b97f4a7c15ull ^ meta.value_seq ^ (uint64_t{value_bytes} << 48));
+  h = mix(h ^ meta.source_time_ns);
+  h = mix(h ^ meta.local_time_ns);
+  const uint8_t* p = static_cast<const uint8_t*>(value);
+  uint32_t i = 0;
+  for (; i + 8 <= value_bytes; i += 8) {
+    uint64_t w;
+    memcpy(&w, p + i, 8);
+    h = mix(h ^ w);
+  }
+  if (i < value_bytes) {
+    uint64_t w = 0;
+    memcpy(&w, p + i, value_bytes - i);
+    h = mix(h ^ w);
+  }
+  return h;
+}
+
+/// What a reader found in a copy.
+enum class CopyResult { kOk, kChanged, kCorrupt };
 
 /// The owner word of a claim: who holds it (reclaim.h gives dead owners' claims back).
 inline uint64_t ClaimOwner(uint64_t t) { return (uint64_t{platform::ProcessId()} << 32) | (t & 0xffffffffu); }
@@ -45,35 +80,38 @@ inline bool ClaimCopy(SlotHeader* slot, uint64_t t) {
 
 /// Stamps and publishes a claimed copy (its sequence word is 2t+1): meta, value, then
 /// the sequence word 2t+2 with release order.
-inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* meta3, uint8_t* data, uint64_t t,
+inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* meta4, uint8_t* data, uint64_t t,
                             uint32_t value_bytes, const void* value, const SlotMeta& meta) {
   SeqlockWriterFence();
-  meta3[0].store(meta.value_seq, kMetaStore);
-  meta3[1].store(meta.source_time_ns, kMetaStore);
-  meta3[2].store(meta.local_time_ns, kMetaStore);
+  meta4[0].store(meta.value_seq, kMetaStore);
+  meta4[1].store(meta.source_time_ns, kMetaStore);
+  meta4[2].store(meta.local_time_ns, kMetaStore);
+  meta4[3].store(CopyCheck(meta, value, value_bytes), kMetaStore);
   StoreWords(data, value, value_bytes);
   seq->store(2 * t + 2, std::memory_order_release);
 }
 
-/// Copies a seqlocked value if it holds complete ticket t; false if not (yet) or if it
-/// changed while being copied.
-inline bool ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta3, const uint8_t* data,
-                     uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+/// Copies a seqlocked value if it holds complete ticket t: kChanged if not (yet) or if
+/// it changed while being copied, kCorrupt if it stayed put but fails its check.
+inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta4, const uint8_t* data,
+                           uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
   uint64_t s1 = seq->load(std::memory_order_acquire);
-  if (s1 != 2 * t + 2) return false;
-  meta->value_seq = meta3[0].load(kMetaLoad);
-  meta->source_time_ns = meta3[1].load(kMetaLoad);
-  meta->local_time_ns = meta3[2].load(kMetaLoad);
+  if (s1 != 2 * t + 2) return CopyResult::kChanged;
+  meta->value_seq = meta4[0].load(kMetaLoad);
+  meta->source_time_ns = meta4[1].load(kMetaLoad);
+  meta->local_time_ns = meta4[2].load(kMetaLoad);
+  const uint64_t check = meta4[3].load(kMetaLoad);
   LoadWords(out, data, value_bytes);
   SeqlockReaderFence();
-  return seq->load(std::memory_order_relaxed) == s1;
+  if (seq->load(std::memory_order_relaxed) != s1) return CopyResult::kChanged;
+  return check == CopyCheck(*meta, out, value_bytes) ? CopyResult::kOk : CopyResult::kCorrupt;
 }
 
 /// A slot's copy (the value follows its header).
 inline void PublishSlot(SlotHeader* slot, uint64_t t, uint32_t value_bytes, const void* value, const SlotMeta& meta) {
   StampAndPublish(&slot->seq, &slot->value_seq, reinterpret_cast<uint8_t*>(slot + 1), t, value_bytes, value, meta);
 }
-inline bool ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+inline CopyResult ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
   return ReadCopy(&slot->seq, &slot->value_seq, reinterpret_cast<const uint8_t*>(slot + 1), t, value_bytes, out, meta);
 }
 

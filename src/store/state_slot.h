@@ -46,7 +46,9 @@ struct StateView {
   }
 };
 
-enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull };
+/// kCorrupt: the copy a read found failed its check (a client wrote over shared memory);
+/// nothing was returned.
+enum class StoreResult { kOk, kNever, kEmpty, kPending, kBusy, kFull, kCorrupt };
 
 /// Claims the cell's inline copy for ticket t, unless a newer ticket holds it or
 /// another writer is filling it (then readers use the slot: nothing is lost). The
@@ -100,8 +102,8 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
   return StoreResult::kBusy;
 }
 
-/// Copies the newest complete value. Returns kOk, kNever (nothing written yet) or
-/// kBusy (writers overtook the reader 16 times in a row).
+/// Copies the newest complete value. Returns kOk, kNever (nothing written yet), kBusy
+/// (writers overtook the reader 16 times in a row) or kCorrupt (see seqlock.h).
 inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
   for (int attempt = 0; attempt < 16; ++attempt) {
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
@@ -114,13 +116,17 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
       uint64_t s1 = v.cell->inline_seq.load(std::memory_order_acquire);
       if (!(s1 & 1) && s1 >= 2 * t + 2) {
         uint64_t ti = s1 / 2 - 1;
-        if (ReadCopy(&v.cell->inline_seq, v.cell->inline_meta, reinterpret_cast<const uint8_t*>(v.cell->inline_value),
-                     ti, v.value_bytes, out, meta))
-          return StoreResult::kOk;
+        const CopyResult r = ReadCopy(&v.cell->inline_seq, v.cell->inline_meta,
+                                      reinterpret_cast<const uint8_t*>(v.cell->inline_value), ti, v.value_bytes, out,
+                                      meta);
+        if (r == CopyResult::kOk) return StoreResult::kOk;
+        if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
         continue;  // refilled while we copied
       }
     }
-    if (ReadSlot(v.slot(t), t, v.value_bytes, out, meta)) return StoreResult::kOk;
+    const CopyResult r = ReadSlot(v.slot(t), t, v.value_bytes, out, meta);
+    if (r == CopyResult::kOk) return StoreResult::kOk;
+    if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
   }
   return StoreResult::kBusy;
 }

@@ -211,3 +211,37 @@ TEST_P(StateSlotConcurrent, ReadersNeverSeeTornValues) {
 }  // namespace
 }  // namespace store
 }  // namespace ccomm
+
+namespace ccomm {
+namespace store {
+namespace {
+
+// A stray write over a complete copy (sequence word untouched) is detected by the
+// copy's check: the reader gets kCorrupt, never the damaged value.
+TEST(StateSlotCheck, DamagedCopyIsDetectedNotReturned) {
+  for (uint32_t bytes : {8u, 16u, 48u}) {  // inline copy, inline limit, slot only
+    std::vector<uint8_t> mem(sizeof(StateCell) + kStateSlots * 128 + 64, 0);
+    auto* base = reinterpret_cast<uint8_t*>(AlignUp(reinterpret_cast<uintptr_t>(mem.data()), 64));
+    StateView v;
+    v.cell = new (base) StateCell();
+    v.slots = base + sizeof(StateCell);
+    v.slot_bytes = 128;
+    v.value_bytes = bytes;
+    std::vector<uint8_t> in(bytes, 0x5a), out(bytes);
+    ASSERT_EQ(StateWrite(v, in.data(), 0, 1, 2), StoreResult::kOk);
+    SlotMeta m;
+    ASSERT_EQ(StateRead(v, out.data(), &m), StoreResult::kOk);
+    // Damage the value in every copy a reader could take (slot and inline line).
+    reinterpret_cast<uint8_t*>(v.slot(0) + 1)[bytes - 1] ^= 0x01;
+    reinterpret_cast<uint8_t*>(v.cell->inline_value)[bytes <= kInlineValueBytes ? bytes - 1 : 0] ^= 0x01;
+    EXPECT_EQ(StateRead(v, out.data(), &m), StoreResult::kCorrupt) << bytes << "-byte value";
+    // The next genuine write is read normally again.
+    ASSERT_EQ(StateWrite(v, in.data(), 0, 3, 4), StoreResult::kOk);
+    ASSERT_EQ(StateRead(v, out.data(), &m), StoreResult::kOk);
+    EXPECT_EQ(out, in);
+  }
+}
+
+}  // namespace
+}  // namespace store
+}  // namespace ccomm

@@ -54,6 +54,8 @@ typedef enum ccomm_status {
 #define CCOMM_E_SYS (-7)     /**< an OS call failed at open; errno says why */
 #define CCOMM_E_VERSION (-8) /**< segment has another layout version than this library */
 #define CCOMM_E_RETIRED (-9) /**< ccommd replaced the segment (new config): close and reopen */
+#define CCOMM_E_CORRUPT (-10) /**< the value in shared memory failed its check (something wrote
+                                   over the segment); nothing returned, counted as `corrupt` */
 
 /** ccomm_info.flags */
 #define CCOMM_INFO_SAFE_VALUE 0x1u /**< the value returned is the configured safe value */
@@ -192,6 +194,7 @@ typedef struct ccomm_signal_stats {
   uint64_t lost;              /**< gaps in the producer's sequence seen by ccommd */
   uint64_t overflow;          /**< events readers lost to ring overrun */
   uint64_t stale_transitions; /**< fresh -> stale seen by ccommd's supervision */
+  uint64_t corrupt;           /**< copies that failed their check (any reader, ccommd included) */
   int64_t last_rx_age_ns;     /**< age of the last received value; -1 if none */
   int32_t stale;              /**< consumed here with stale_after_ms, and older than that (or never) */
 } ccomm_signal_stats;

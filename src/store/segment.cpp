@@ -180,6 +180,19 @@ std::string CheckLayout(const void* base, size_t size) {
   return "";
 }
 
+// An existing segment that failed its layout check (a client wrote over it, or another
+// version made it): clients still attached must reopen, so mark it retired anyway.
+static void RetireDamaged(const std::string& name) {
+  int fd = platform::ShmOpen(name.c_str(), false, 0);
+  if (fd < 0) return;
+  size_t size = 0;
+  void* p = platform::FileSize(fd, &size) == 0 && size >= sizeof(SegmentHeader) ? platform::MapShared(fd, size) : nullptr;
+  platform::CloseFd(fd);
+  if (!p) return;
+  static_cast<SegmentHeader*>(p)->state.store(kRetired, std::memory_order_release);
+  platform::Unmap(p, size);
+}
+
 // Compares the immutable part (header identity, directory, names, safe values) of an
 // existing segment with what this configuration would build.
 static bool SameLayout(const void* existing, const void* planned, size_t size) {
@@ -226,6 +239,7 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
     old.header()->state.store(kRetired, std::memory_order_release);
     old.Close();
   }
+  if (r == -EPROTO) RetireDamaged(name);
   platform::ShmUnlink(name.c_str());  // also removes a half-created or foreign segment
   int fd = platform::ShmOpen(name.c_str(), true, 0660);
   if (fd < 0) {

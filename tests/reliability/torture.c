@@ -147,7 +147,7 @@ static uint64_t* last_of(uint64_t id) {
 
 static int cmd_check(struct conn* k, double duration) {
   int64_t v[MAX_COUNT];
-  uint64_t reads = 0, values = 0, fresh = 0, stale = 0, never = 0, busy = 0, order = 0;
+  uint64_t reads = 0, values = 0, fresh = 0, stale = 0, never = 0, busy = 0, order = 0, detected = 0;
   uint64_t last_seq = 0;
   const uint64_t end = duration > 0 ? now_ns() + (uint64_t)(duration * 1e9) : UINT64_MAX;
   uint64_t report = now_ns() + 1000000000ull;
@@ -160,6 +160,7 @@ static int cmd_check(struct conn* k, double duration) {
     reads++;
     if (r == CCOMM_E_RETIRED) { if (attach(k)) break; continue; }
     if (r == CCOMM_E_BUSY) { busy++; continue; }
+    if (r == CCOMM_E_CORRUPT) { detected++; continue; }  /* damaged in shared memory: refused */
     if (r < 0) { fprintf(stderr, "torture: read: %s\n", ccomm_strerror(r)); return 1; }
     if (r == CCOMM_NEVER) { never++; continue; }
     if (r == CCOMM_EMPTY) { usleep(200); continue; }
@@ -197,8 +198,8 @@ static int cmd_check(struct conn* k, double duration) {
   }
   printf("{\"check\":\"%s\",\"final\":true,\"reads\":%" PRIu64 ",\"values\":%" PRIu64 ",\"fresh\":%" PRIu64
          ",\"stale\":%" PRIu64 ",\"never\":%" PRIu64 ",\"busy\":%" PRIu64 ",\"order_violations\":%" PRIu64
-         ",\"writers\":%u,\"reopens\":%u,\"corrupt\":false}\n",
-         k->name, reads, values, fresh, stale, never, busy, order, nwriters, k->reopens);
+         ",\"writers\":%u,\"reopens\":%u,\"detected\":%" PRIu64 ",\"corrupt\":false}\n",
+         k->name, reads, values, fresh, stale, never, busy, order, nwriters, k->reopens, detected);
   return 0;
 }
 

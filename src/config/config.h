@@ -78,11 +78,25 @@ struct NetworkConfig {
   std::string auth_key_file;   // empty = no authentication
 };
 
+// <ros2>: what ccomm-ros2 on one node bridges (local policy, not in the hash).
+// Parsed and checked by ros2_section.cpp; docs/integrations/ros2.md.
+struct Ros2Config {
+  std::string node;                   // the node the bridge runs on
+  std::string ros_namespace = "ccomm";
+  uint32_t domain = 0;                // ROS 2 domain id 0..232
+  bool has_domain = false;
+  bool publish_given = false;         // false: every signal the node consumes
+  std::vector<std::string> publish;   // ccomm -> ROS 2
+  std::vector<std::string> subscribe; // ROS 2 -> ccomm (signals the node produces)
+  int line = 0;
+};
+
 struct SystemConfig {
   std::string path;            // file it was read from
   NetworkConfig network;
   std::vector<NodeConfig> nodes;
   std::vector<SignalConfig> signals;
+  std::vector<Ros2Config> ros2;  // at most one per node
   uint32_t hash = 0;           // FNV-1a over a canonical form of what both ends must agree on
                                // (node names/order, signal name/type/count/kind/producer/
                                // consumers, ethertype, udp port); not whitespace or comments,

@@ -103,6 +103,7 @@ void Parser::CrossCheck(SystemConfig* cfg) {
       }
     }
   }
+  CrossCheckRos2(cfg);
 }
 
 }  // namespace config_detail

@@ -153,7 +153,7 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
   int nodes_seen = 0, signals_seen = 0;
   int node_elements = 0;
   for (const Node* c = root->first_node("node"); c; c = c->next_sibling("node")) ++node_elements;
-  const std::vector<std::string> kChildren = {"network", "node", "signal"};
+  const std::vector<std::string> kChildren = {"network", "node", "signal", "ros2"};
   for (const Node* c = root->first_node(); c; c = c->next_sibling()) {
     if (c->type() != rapidxml::node_element) continue;
     std::string_view name = NameOf(c);
@@ -181,9 +181,13 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
         cfg->signals.push_back(std::move(sig));
         refs_.push_back(std::move(refs));
       }
+    } else if (name == "ros2") {
+      Ros2Config r;
+      Ros2Element(c, &r);
+      cfg->ros2.push_back(std::move(r));
     } else {
       std::string hint = Suggest(name, kChildren);
-      if (hint.empty()) hint = " (expected network, node or signal)";
+      if (hint.empty()) hint = " (expected network, node, signal or ros2)";
       Err(line, "unknown element <" + std::string(name) + "> in <ccomm>" + hint);
     }
   }

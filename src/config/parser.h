@@ -137,6 +137,8 @@ class Parser {
   void SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs);
   void SafeValue(const AttrValue& a, SignalConfig* sig);
   void CrossCheck(SystemConfig* cfg);
+  void Ros2Element(const Node* n, Ros2Config* out);     // ros2_section.cpp
+  void CrossCheckRos2(SystemConfig* cfg);               // ros2_section.cpp
 
   bool Name(const Element& e, const char* what, std::string* out);
   template <typename T>

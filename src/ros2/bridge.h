@@ -19,11 +19,16 @@ enum class StampMode { kWrite, kArrival };
 struct Options {
   std::string node;                  // empty: $CCOMM_NODE, else the hostname
   std::string ros_namespace = "ccomm";
+  bool namespace_given = false;      // on the command line (wins over <ros2>)
   int domain = 0;
+  bool domain_given = false;         // --domain (wins over <ros2>, which wins over $ROS_DOMAIN_ID)
+  std::string config_path;           // signals.xml with the <ros2> section ("" = none)
+  bool config_given = false;
   std::vector<std::string> publish;  // ccomm -> ROS 2; empty: every signal consumed here
   bool publish_given = false;
   std::vector<std::string> subscribe;  // ROS 2 -> ccomm: signals produced here
   StampMode stamp = StampMode::kWrite;
+  int priority = 0;                  // SCHED_FIFO priority of the ccomm -> ROS 2 thread (0: none)
   double stats_interval_s = 0;       // 0: stats only on SIGUSR1 and at exit
   bool list_only = false;
   int verbose = 0;
@@ -32,6 +37,10 @@ struct Options {
 // Parses argv into `o`; returns -1 to go on, else the exit status (help printed: 0,
 // usage error: 2, with a message on stderr).
 int ParseOptions(int argc, char** argv, Options* o);
+
+// Takes what the command line left open from the <ros2 node=NODE> section of
+// o->config_path (config_section.cpp). False with the file's errors on stderr.
+bool ApplyConfigSection(Options* o, const std::string& node);
 
 // A signal name usable as one ROS 2 topic name token.
 bool ValidRosTopicToken(const std::string& s);

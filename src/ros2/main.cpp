@@ -165,6 +165,10 @@ int main(int argc, char** argv) {
   ccomm_client* c = OpenWaiting(&b);
   if (!c) return 1;
   b.node = ccomm_node_name(c);
+  if (!ApplyConfigSection(&b.opt, b.node)) {
+    ccomm_close(c);
+    return 2;
+  }
   bool ok = BuildRoutes(&b, c);
   ccomm_close(c);
   if (!ok) return 2;

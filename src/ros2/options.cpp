@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccomm-ros2 command line.
 #include <getopt.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -24,9 +25,14 @@ const char kUsage[] =
     "Options:\n"
     "  -n, --node NODE           ccomm node to attach to (default: $CCOMM_NODE, else the\n"
     "                            hostname); ccommd must run as that node\n"
+    "  -c, --config FILE         signals.xml whose <ros2 node=NODE> element gives the\n"
+    "                            namespace, domain, publish and subscribe lists (default:\n"
+    "                            /etc/ccomm/signals.xml if it exists; '' for none);\n"
+    "                            options given here win over it\n"
     "  -s, --namespace NS        ROS 2 namespace of the topics (default: ccomm; '' or /\n"
     "                            for none)\n"
-    "  -d, --domain ID           ROS 2 domain id, 0..232 (default: $ROS_DOMAIN_ID, else 0)\n"
+    "  -d, --domain ID           ROS 2 domain id, 0..232 (default: <ros2 domain=>, else\n"
+    "                            $ROS_DOMAIN_ID, else 0)\n"
     "  -p, --publish SIG[,SIG]   signals to publish to ROS 2 (default: every signal this\n"
     "                            node consumes; 'none' for none); repeatable\n"
     "  -S, --subscribe SIG[,SIG] signals produced by this node to take from ROS 2 topics;\n"
@@ -35,6 +41,9 @@ const char kUsage[] =
     "                            the producer (default; exact when the producer's\n"
     "                            CLOCK_MONOTONIC is this node's), or the time the value\n"
     "                            reached this node (for boards whose clocks differ)\n"
+    "      --priority N          run the ccomm -> ROS 2 thread SCHED_FIFO at priority N\n"
+    "                            (1..99): a state signal changing at 1 kHz needs the bridge\n"
+    "                            to read it within 1 ms, or it sees only the newest value\n"
     "      --stats SECONDS       print the counters as one JSON line every SECONDS\n"
     "                            (always on SIGUSR1 and at exit)\n"
     "  -l, --list                print the topics, types and QoS the bridge would use, and exit\n"
@@ -90,23 +99,29 @@ bool ValidRosName(const std::string& s, bool allow_slash) {
 }  // namespace
 
 int ParseOptions(int argc, char** argv, Options* o) {
-  enum { kStamp = 1000, kStats };
+  enum { kStamp = 1000, kStats, kPriority };
   static const struct option kLong[] = {
       {"node", required_argument, nullptr, 'n'},   {"namespace", required_argument, nullptr, 's'},
       {"domain", required_argument, nullptr, 'd'}, {"publish", required_argument, nullptr, 'p'},
       {"subscribe", required_argument, nullptr, 'S'}, {"stamp", required_argument, nullptr, kStamp},
-      {"stats", required_argument, nullptr, kStats}, {"list", no_argument, nullptr, 'l'},
+      {"stats", required_argument, nullptr, kStats},
+      {"priority", required_argument, nullptr, kPriority}, {"list", no_argument, nullptr, 'l'},
       {"verbose", no_argument, nullptr, 'v'},      {"help", no_argument, nullptr, 'h'},
+      {"config", required_argument, nullptr, 'c'},
       {nullptr, 0, nullptr, 0}};
   if (const char* env = getenv("ROS_DOMAIN_ID"); env && *env) {
     if (!ParseDomain(env, "from ROS_DOMAIN_ID", &o->domain)) return 2;
   }
   int ch;
-  while ((ch = getopt_long(argc, argv, "n:s:d:p:S:lvh", kLong, nullptr)) != -1) {
+  while ((ch = getopt_long(argc, argv, "n:s:d:p:S:c:lvh", kLong, nullptr)) != -1) {
     switch (ch) {
       case 'n': o->node = optarg; break;
-      case 's': o->ros_namespace = optarg; break;
-      case 'd': if (!ParseDomain(optarg, "--domain", &o->domain)) return 2; break;
+      case 's': o->ros_namespace = optarg; o->namespace_given = true; break;
+      case 'd':
+        if (!ParseDomain(optarg, "--domain", &o->domain)) return 2;
+        o->domain_given = true;
+        break;
+      case 'c': o->config_path = optarg; o->config_given = true; break;
       case 'p':
         o->publish_given = true;
         if (strcmp(optarg, "none") != 0) SplitInto(optarg, &o->publish);
@@ -126,6 +141,16 @@ int ParseOptions(int argc, char** argv, Options* o) {
         }
         break;
       }
+      case kPriority: {
+        char* end = nullptr;
+        long p = strtol(optarg, &end, 10);
+        if (*end || p < 1 || p > 99) {
+          fprintf(stderr, "ccomm-ros2: --priority must be 1..99 (SCHED_FIFO), not '%s'\n", optarg);
+          return 2;
+        }
+        o->priority = static_cast<int>(p);
+        break;
+      }
       case 'l': o->list_only = true; break;
       case 'v': ++o->verbose; break;
       case 'h': fputs(kUsage, stdout); return 0;
@@ -136,6 +161,7 @@ int ParseOptions(int argc, char** argv, Options* o) {
     fprintf(stderr, "ccomm-ros2: unexpected argument '%s' (see --help)\n", argv[optind]);
     return 2;
   }
+  if (!o->config_given && access("/etc/ccomm/signals.xml", R_OK) == 0) o->config_path = "/etc/ccomm/signals.xml";
   std::string& ns = o->ros_namespace;  // stored without leading/trailing '/'
   while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
   while (!ns.empty() && ns.back() == '/') ns.pop_back();

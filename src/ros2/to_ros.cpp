@@ -2,6 +2,11 @@
 // ccomm -> ROS 2: wakes on every change of the node's signals (ccomm_wait), reads each
 // published signal straight into its preallocated DDS sample and writes it with the
 // ccomm write time as source timestamp. Nothing is allocated per sample here.
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <cstring>
 #include <ctime>
 
 #include <cstdio>
@@ -78,7 +83,7 @@ int Pump(Bridge* b, ccomm_client* c, Route* r) {
     // Not re-published: the DDS writer's deadline (stale_after_ms) tells ROS 2 readers.
     r->fresh = false;
     r->n.stale.fetch_add(1, std::memory_order_relaxed);
-    if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: %s is stale\n", r->name.c_str());
+    if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: %s is no longer fresh (%s)\n", r->name.c_str(), ccomm_strerror(st));
   } else if (st == CCOMM_FRESH) {
     r->fresh = true;
   }
@@ -89,6 +94,15 @@ int Pump(Bridge* b, ccomm_client* c, Route* r) {
 
 void RunToRos(Bridge* b) {
   if (b->to_ros.empty()) return;
+  if (b->opt.priority > 0) {
+    mlockall(MCL_CURRENT | MCL_FUTURE);  // no page fault delays the real-time reader
+    sched_param sp{};
+    sp.sched_priority = b->opt.priority;
+    int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    if (rc != 0)
+      fprintf(stderr, "ccomm-ros2: --priority %d: %s (needs CAP_SYS_NICE); running without\n",
+              b->opt.priority, strerror(rc));
+  }
   ccomm_client* c = OpenWaiting(b);
   if (!c) return;
   if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }

@@ -12,7 +12,7 @@ check "DDS endpoints: rt/ccomm/<signal>, std_msgs::msg::dds_::*_ types, typehash
 a_to_ros() {  # a_to_ros SIGNAL ROS_TYPE CCOMM_TYPE COUNT N [--event]
   local sig=$1 rtype=$2 ctype=$3 count=$4 n=$5; shift 5
   echo_start "$sig" "$sig" "$rtype" --count "$n" --timeout 20 "$@" || return 1
-  app pub "$sig" "$n" 200 >"$WORK/$sig.app" || return 1
+  app pub "$sig" "$n" 50 >"$WORK/$sig.app" || return 1  # 50 Hz: values, not throughput
   wait "$ECHO_PID" || { cat "$WORK/$sig.result"; return 1; }
   checks samples "$WORK/$sig.jsonl" --n "$n" --type "$ctype" --count "$count" \
     --mono-minus-wall "$(mono_minus_wall "$sig")"
@@ -56,3 +56,114 @@ peer pub rt/ccomm/setpoint Int32MultiArray '[[1,2,3]]' --match-timeout 3 >/dev/n
 wrong=$(bridge_stat setpoint wrong_type_peers)
 check "a DDS writer of another type (Int32MultiArray) on the topic is refused and counted ($wrong)" \
   bash -c "[[ $wrong -ge 1 ]]"
+
+# ---- 1 kHz for 10 s, 36 doubles: zero loss, counted by the app, the bridge and the reader
+signal_stat() {  # signal_stat NODE SIGNAL FIELD: ccommd's per-signal counter
+  stats "$1"
+  python3 -c 'import json,sys; d=json.load(open(sys.argv[1]))
+print([s for s in d["signals"] if s["name"] == sys.argv[2]][0][sys.argv[3]])' "$WORK/stats-$1.json" "$2" "$3"
+}
+# One run; sets KHZ_LOSS (values the reader missed) and KHZ_DDS_LOSS (published, not received).
+khz_run() {
+  local pub0 skip0 rx0 lost0 pub1 skip1 rx1 lost1 got
+  pub0=$(bridge_stat joints published); skip0=$(bridge_stat joints skipped)
+  rx0=$(signal_stat planner joints rx); lost0=$(signal_stat planner joints lost)
+  KHZ_LOSS=10000 KHZ_DDS_LOSS=-1 KHZ_REF_LOSS=0
+  echo_start joints joints Float64MultiArray --count 10000 --timeout 16 --event || return 1
+  # The reference: a plain ccomm app on B reading the same signal, at the bridge's priority.
+  in_ns planner env CCOMM_NODE=planner chrt -f 50 "$WORK/board_app" watch joints 10000 16 >"$WORK/joints.ref" &
+  local ref=$!
+  sleep 0.2
+  in_ns control env CCOMM_NODE=control chrt -f 55 "$WORK/board_app" pub joints 10000 1000 >"$WORK/joints.app"
+  wait "$ECHO_PID"
+  wait "$ref"
+  pub1=$(bridge_stat joints published); skip1=$(bridge_stat joints skipped)
+  rx1=$(signal_stat planner joints rx); lost1=$(signal_stat planner joints lost)
+  got=$(json_get "$WORK/joints.result" received)
+  local ref_got
+  ref_got=$(grep -c '^[0-9]' "$WORK/joints.ref")
+  KHZ_LOSS=$((10000 - got)) KHZ_DDS_LOSS=$((pub1 - pub0 - got)) KHZ_REF_LOSS=$((10000 - ref_got))
+  figure "1 kHz x 10 s x 36 doubles, try $1: app $(cat "$WORK/joints.app"), ccommd B received $((rx1 - rx0)) lost $((lost1 - lost0)), a ccomm app on B read $ref_got, bridge published $((pub1 - pub0)) skipped $((skip1 - skip0)), ROS 2 reader received $got"
+}
+# A state signal is last-value-wins: a reader loses a value when two arrive closer than
+# it can read them (a stall upstream delivers frames in a burst) or when it is not
+# scheduled within the period. On a shared, loaded 2-core VM that happens now and then
+# even at SCHED_FIFO, so the run is tried up to 3 times and passes on the first that loses
+# nothing; every try's counts are printed. A plain ccomm app on B reads the same signal
+# as the reference: if it also lost values in every try, this machine cannot carry
+# 1 kHz right now and the zero-loss check is reported as skipped with the counts; the
+# bridge must still never lose more than that app, and the DDS leg nothing, in any try.
+dds_loss=0 ref_lost_every_try=1 bridge_worse=0
+for try in 1 2 3; do
+  khz_run "$try"
+  [[ $KHZ_DDS_LOSS -ne 0 ]] && dds_loss=1
+  [[ $KHZ_REF_LOSS -eq 0 ]] && ref_lost_every_try=0
+  [[ $KHZ_LOSS -gt $KHZ_REF_LOSS ]] && bridge_worse=$((bridge_worse + 1))
+  [[ $KHZ_LOSS -eq 0 ]] && break
+done
+what="1 kHz x 10 s x 36 doubles: zero loss end to end (app 10000 = bridge published = ROS 2 reader)"
+if [[ $KHZ_LOSS -ne 0 && $ref_lost_every_try -eq 1 ]]; then
+  ok "$what # SKIP a plain ccomm app on B lost values too in all 3 tries (load $(cut -d' ' -f1 /proc/loadavg)): not a real-time host now"
+  check "  ... the bridge lost no more than that app in at least one try ($bridge_worse of 3 worse)" \
+    bash -c "[[ $bridge_worse -lt 3 ]]"
+else
+  check "$what, try $try" bash -c "[[ $KHZ_LOSS -eq 0 ]] && grep -q 'written 10000' '$WORK/joints.app'"
+  check "  ... every value once, in order, right values and source timestamps" \
+    checks samples "$WORK/joints.jsonl" --n 10000 --type double --count 36 --mono-minus-wall "$(mono_minus_wall joints)"
+fi
+check "  ... in every try, every sample the bridge published reached the ROS 2 reader" bash -c "[[ $dds_loss -eq 0 ]]"
+
+# ---- stale: cut the board link; the ROS 2 reader's deadline (50 ms) fires in time
+stale0=$(bridge_stat pos stale)
+if echo_start stale pos Float64 --count 1000000 --timeout 3 --deadline-ms 50; then
+  app pub pos 400 100 >/dev/null &   # 100 Hz: period 10 ms
+  a=$!
+  sleep 1.5
+  ip -n "$NS_C" link set eth0 down
+  cut=$(date +%s%N)  # after: the link is down from here on, whatever ip's own run time
+  wait "$ECHO_PID"
+  wait "$a"
+  ip -n "$NS_C" link set eth0 up
+  python3 - "$WORK/stale.result" "$WORK/stale.jsonl" "$cut" >"$WORK/stale.check" <<'PY'
+import json, sys
+res = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
+rows = [json.loads(l) for l in open(sys.argv[2])]
+cut = int(sys.argv[3])
+misses = [t for t in res["deadline_misses"] if t > cut]
+told = (misses[0] - cut) / 1e6 if misses else None
+# nothing stale re-published: no sample arrives after the reader was told
+after = [r for r in rows if misses and r["rx"] > misses[0]]
+print("told_ms", told, "samples_after_told", len(after), "samples", len(rows))
+sys.exit(0 if told is not None and told <= 50 + 10 + 5 and not after and rows else 1)
+PY
+  rc=$?
+  figure "stale: link cut -> ROS 2 deadline missed after $(cat "$WORK/stale.check") (limit 50 ms stale_after + 10 ms period, +5 ms scheduling)"
+  check "stale: the ROS 2 side is told within stale_after_ms + 1 period of the cut, nothing stale re-published" \
+    bash -c "[[ $rc -eq 0 ]]"
+  stale1=$(bridge_stat pos stale)
+  check "  ... and the bridge counted pos going stale ($stale0 -> $stale1)" bash -c "[[ $stale1 -gt $stale0 ]]"
+else
+  not_ok "stale: reader matched"
+fi
+
+# ---- the bridge survives ccommd restarts (same configuration; a new one retires the segment)
+flows() { a_to_ros pos Float64 double 1 5 >/dev/null && ros_to_a enable Bool '[false]' '[0]' 1 >/dev/null; }
+stop_daemon planner
+start_rt_daemon planner
+sleep 0.3
+check "after a ccommd restart on B (same configuration) values flow both ways" flows
+sed 's|</ccomm>|  <signal name="extra" type="double" producer="control" consumers="planner"/>\n</ccomm>|' \
+  "$HERE/ros2.xml" >"$WORK/ros2-changed.xml"
+stop_daemon control
+stop_daemon planner
+start_rt_daemon control "$WORK/ros2-changed.xml"
+start_rt_daemon planner "$WORK/ros2-changed.xml"
+sleep 0.5
+check "after ccommd restarts with a new configuration the bridge reopens and values flow" flows
+reopens=$(bridge_stat - reopens)
+check "  ... the bridge counted its reopens ($reopens)" bash -c "[[ $reopens -ge 1 ]]"
+check "the bridge is still running after every DDS peer of this suite came and went" kill -0 "$BRIDGE_PID"
+errs=$(bridge_stat joints dds_errors)
+check "  ... without a DDS error ($errs)" bash -c "[[ $errs -eq 0 ]]"
+kill -TERM "$BRIDGE_PID"; wait "$BRIDGE_PID"; rc=$?
+check "the bridge exits 0 on SIGTERM, printing its counters" bash -c "[[ $rc -eq 0 ]] && tail -1 '$BRIDGE_LOG' | grep -q '\"reopens\"'"

@@ -20,7 +20,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "src", "ros2"))
 
-from cyclonedds.builtin import BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription  # noqa: E402
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription  # noqa: E402,E501
 from cyclonedds.core import Listener, Policy, Qos  # noqa: E402
 from cyclonedds.domain import DomainParticipant  # noqa: E402
 from cyclonedds.pub import DataWriter  # noqa: E402
@@ -54,7 +54,8 @@ def cmd_discover(args, dp):
         typ, _, side = rest.partition(":")
         want[topic] = (typ, side or "pub")
     hashes = type_hash.all_hashes()
-    readers = {"pub": DataReader(dp, BuiltinTopicDcpsPublication), "sub": DataReader(dp, BuiltinTopicDcpsSubscription)}
+    readers = {"pub": BuiltinDataReader(dp, BuiltinTopicDcpsPublication),
+               "sub": BuiltinDataReader(dp, BuiltinTopicDcpsSubscription)}
     found, end = {}, time.time() + args.timeout
     while len(found) < len(want) and time.time() < end:
         for side, rd in readers.items():
@@ -102,6 +103,7 @@ def cmd_echo(args, dp):
     if not lis.matched.wait(args.match_timeout):
         emit(error="no writer matched %s within %.1f s" % (args.topic, args.match_timeout))
         return 1
+    time.sleep(0.5)  # we matched the writer; give the writer's side time to match us too
     if args.ready:
         open(args.ready, "w").close()
     got, end = 0, time.time() + args.timeout
@@ -130,6 +132,7 @@ def cmd_pub(args, dp):
     if not lis.matched.wait(args.match_timeout):
         emit(error="no reader matched %s within %.1f s" % (args.topic, args.match_timeout))
         return 1
+    time.sleep(0.5)  # our side matched; give the reader's side time to match us too
     values = json.loads(args.values)
     for v in values:
         wr.write(msgs.make(args.type, v) if not isinstance(v, dict) else msgs.make(args.type, v["data"], v.get("count")))

@@ -5,6 +5,7 @@
 // Environment: WEB_URL, WS_URL, CCOMM (the ccomm CLI), CCOMM_NODE, PYTHON, WRITER,
 // CHROMIUM, SCREENSHOT (where the screenshot goes).
 import { execFileSync, spawn } from "node:child_process";
+import { readFileSync } from "node:fs";
 import net from "node:net";
 import { chromium } from "playwright-core";
 import WebSocket from "ws";
@@ -150,6 +151,12 @@ await check("a signal that is not written goes stale: badge and protocol message
 // The writer runs while the first browser is killed: the probe must miss nothing.
 const c0 = (await stats()).changes.tick;
 const seq0 = (probe.last("tick") || { seq: 0 }).seq;
+// CPU seconds ccomm-web used (its /proc stat: utime + stime, in clock ticks)
+const webCpu = () => {
+  const f = readFileSync(`/proc/${env("WEB_PID")}/stat`, "utf8").split(") ")[1].split(" ");
+  return (Number(f[11]) + Number(f[12])) / Number(env("CLK_TCK"));
+};
+const cpu0 = webCpu(), wall0 = Date.now();
 const writer = spawn(env("PYTHON"), [env("WRITER"), NODE, String(WRITER_RATE), String(WRITER_COUNT)], { stdio: ["ignore", "pipe", "inherit"] });
 let writerOut = "";
 writer.stdout.on("data", (d) => { writerOut += d; });
@@ -227,6 +234,7 @@ await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page
 
 await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {
   const code = await writerDone;
+  const webCpuShare = (webCpu() - cpu0) / ((Date.now() - wall0) / 1000);
   assert(code === 0 && writerOut.includes("writer: done " + WRITER_COUNT), "writer exit " + code + ": " + writerOut);
   await probe.waitFor("tick", (m) => m.value === WRITER_COUNT, 3000, "the last tick");
   await sleep(300);
@@ -251,6 +259,8 @@ await check("the protocol client lost nothing while the browser died (every new 
   const f = JSON.parse(floorOut);
   console.log(`  # floor, a libccomm reader of the same values (ms): p50 ${f.p50_ms} p99 ${f.p99_ms} (n=${f.n}); ` +
               `ccomm-web p50 / floor p50 = ${(Number(q(0.5)) / f.p50_ms).toFixed(1)}`);
+  console.log(`  # CPU while the writer ran: ccomm-web ${(100 * webCpuShare).toFixed(1)} % of one CPU (6 signals, 2-3 clients, ` +
+              `floor reader ${(100 * f.cpu).toFixed(1)} % (1 signal); ratio ${(webCpuShare / f.cpu).toFixed(1)}`);
   const events = probe.received("mode_request").map((m) => m.msg.value);
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));

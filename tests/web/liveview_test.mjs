@@ -259,7 +259,7 @@ await check("the protocol client lost nothing while the browser died (every new 
   const f = JSON.parse(floorOut);
   console.log(`  # floor, a libccomm reader of the same values (ms): p50 ${f.p50_ms} p99 ${f.p99_ms} (n=${f.n}); ` +
               `ccomm-web p50 / floor p50 = ${(Number(q(0.5)) / f.p50_ms).toFixed(1)}`);
-  console.log(`  # CPU while the writer ran: ccomm-web ${(100 * webCpuShare).toFixed(1)} % of one CPU (6 signals, 2-3 clients, ` +
+  console.log(`  # CPU while the writer ran: ccomm-web ${(100 * webCpuShare).toFixed(1)} % of one CPU (6 signals, 2-3 clients), ` +
               `floor reader ${(100 * f.cpu).toFixed(1)} % (1 signal); ratio ${(webCpuShare / f.cpu).toFixed(1)}`);
   const events = probe.received("mode_request").map((m) => m.msg.value);
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);

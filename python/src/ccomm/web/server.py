@@ -212,6 +212,7 @@ def _handler(server: LiveServer) -> type:
         """GET only: the page, its static files, /vendor (uPlot), /config.json, /stats.json."""
 
         server_version = "ccomm-web"
+        timeout = 10  # seconds a connection may idle: one that never sends cannot pin a thread
 
         def log_message(self, format: str, *args: Any) -> None:  # noqa: A002
             pass  # one line per request would drown the start-up lines; refusals are counted

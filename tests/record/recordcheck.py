@@ -11,6 +11,8 @@ for) or late: what an overloaded host causes (a state value replaced before anyo
   recordcheck.py throughput STATS.json RATE        the recorder missed nothing at >= RATE values/s
   recordcheck.py forge OUT.mcap other|changed|foreign   a recording replay must refuse
   recordcheck.py corrupt IN.mcap OUT.mcap         IN with bytes of its first chunk overwritten
+  recordcheck.py fuzz N WORKDIR                    N mutated recordings: loaded or refused, no crash
+  recordcheck.py floor N WORKDIR                   CPU ns per message of the mcap library alone
   recordcheck.py count FILE.mcap                   number of messages (mcap's own reader)
 """
 import json
@@ -170,6 +172,104 @@ def corrupt(src: str, out: str) -> None:
     open(out, "wb").write(data)
 
 
+def small_recording(path: str) -> None:
+    """A valid recording made by ccomm-record's own writer from made-up captured records:
+    a double, a double[4] with NaN and infinities, an int32 and a bool event signal."""
+    import struct
+    from ccomm.mcap_io.capi import SignalDesc
+    from ccomm.mcap_io.schema import RECORD
+    from ccomm.mcap_io.writer import RecordingWriter, WriterOptions
+    sigs = [SignalDesc(0, "speed", "double", 1, 8, False, True, False, "a", 0),
+            SignalDesc(1, "pose", "double", 4, 32, False, True, False, "a", 0),
+            SignalDesc(2, "mode", "int32", 1, 4, False, True, False, "a", 0),
+            SignalDesc(3, "estop", "bool", 1, 1, True, True, False, "a", 0)]
+    w = RecordingWriter(WriterOptions(output=path, signals=sigs, node="a", chunk_size=2048))
+    w._open()
+    buf = bytearray()
+    for k in range(1, 201):
+        t = 1_000_000 * k
+        buf += RECORD.pack(0, 0, 0, k, t + 50, t, 0) + struct.pack("<d", k / 3)
+        buf += RECORD.pack(1, 1, 0, k, t + 50, t, 0) + struct.pack("<4d", k, float("nan"), float("inf"), -k)
+        buf += RECORD.pack(2, 0, 0, k, t + 50, t, 0) + struct.pack("<i", -k)
+        if k % 10 == 0:
+            buf += RECORD.pack(3, 0, 0, k // 10, t + 50, t, 0) + struct.pack("<?", k % 20 == 0)
+    assert w.add(buf) == len(buf)
+    w._close()
+
+
+def fuzz(iterations: int, workdir: str) -> int:
+    """Mutated recordings (cut, flipped bytes, junk, repeated slices) into replay's reader
+    and --recover: each must load, or fail with RecordingError (a clear message); anything
+    else (a crash, another exception) fails."""
+    import os
+    import random
+    from ccomm.mcap_io.recording import RecordingError, load, recover
+    base = os.path.join(workdir, "fuzz-base.mcap")
+    small_recording(base)
+    rec = load(base)
+    pose = rec.signals["pose"].values[0][2]
+    import struct
+    v = struct.unpack("<4d", pose)
+    if not (v[0] == 1 and v[1] != v[1] and v[2] != v[2] and v[3] == -1):  # nan/inf are null -> NaN
+        print(f"# small recording reads back wrong: {v}")
+        return 1
+    data = open(base, "rb").read()
+    rng = random.Random(16)
+    outcomes = {"loaded": 0, "refused": 0}
+    path, fixed = os.path.join(workdir, "fuzz.mcap"), os.path.join(workdir, "fuzz-fixed.mcap")
+    for i in range(iterations):
+        d = bytearray(data)
+        kind = i % 4
+        if kind == 0:
+            d = d[:rng.randrange(len(d))]
+        elif kind == 1:
+            for _ in range(rng.randint(1, 16)):
+                d[rng.randrange(len(d))] ^= 1 << rng.randrange(8)
+        elif kind == 2:
+            at = rng.randrange(len(d))
+            d[at:at + rng.randint(1, 64)] = bytes(rng.randrange(256) for _ in range(rng.randint(1, 64)))
+        else:
+            at, n = rng.randrange(len(d)), rng.randint(1, 200)
+            d[at:at] = d[rng.randrange(len(d)):][:n]
+        open(path, "wb").write(d)
+        for what in ("load", "recover"):
+            try:
+                load(path) if what == "load" else recover(path, fixed)
+                outcomes["loaded"] += 1
+            except RecordingError:
+                outcomes["refused"] += 1
+            except Exception as e:  # noqa: BLE001 - exactly what this test looks for
+                print(f"# fuzz case {i} (mutation {kind}), {what}: {type(e).__name__}: {e}")
+                open(os.path.join(workdir, f"fuzz-crash-{i}.mcap"), "wb").write(d)
+                return 1
+    print(f"# fuzz: {iterations} mutated recordings x (load, recover): {outcomes}")
+    return 0
+
+
+def library_floor(n: int, workdir: str) -> int:
+    """The floor of the recorder's writer: CPU ns per message of the mcap library alone
+    (Writer.add_message of ready-made JSON messages like the recorder's, lz4 chunks of
+    1 MiB), with neither capture nor encoding."""
+    import os
+    import time
+    from mcap.writer import CompressionType, Writer
+    msg = (b'{"value":1234.0,"seq":1234,"source_time_ns":1381313350794,"receive_time_ns":'
+           b'1381313391035,"status":"fresh","fresh":true,"safe_value":false,"lost":0,"gap":0}')
+    with open(os.path.join(workdir, "floor.mcap"), "wb") as f:
+        w = Writer(f, compression=CompressionType.LZ4)
+        w.start()
+        sid = w.register_schema("ccomm.double", "jsonschema", b"{}")
+        chans = [w.register_channel(f"s{i}", "json", sid) for i in range(100)]
+        c0 = time.process_time()
+        for k in range(n):
+            w.add_message(chans[k % 100], 1_000_000 * k, msg, 1_000_000 * k, k)
+        w.finish()
+        cpu = time.process_time() - c0
+    os.unlink(os.path.join(workdir, "floor.mcap"))
+    print("%.0f" % (cpu / n * 1e9))
+    return 0
+
+
 def count_messages(path: str) -> int:
     with open(path, "rb") as f:
         return sum(1 for _ in make_reader(f).iter_messages())
@@ -192,6 +292,10 @@ def main() -> int:
     if cmd == "corrupt":
         corrupt(args[0], args[1])
         return 0
+    if cmd == "fuzz":
+        return fuzz(int(args[0]), args[1])
+    if cmd == "floor":
+        return library_floor(int(args[0]), args[1])
     if cmd == "count":
         print(count_messages(args[0]))
         return 0

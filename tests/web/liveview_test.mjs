@@ -286,6 +286,22 @@ await check("ccommd stopped: every client is told (status message, page banner),
   assert((await stats()).daemon_alive === true, "stats.json daemon_alive again");
 });
 
+let restarted = null;
+await check("ccomm-web restarted: the open page reconnects by itself and shows new values", async () => {
+  const pid = Number(env("WEB_PID"));
+  const alive = () => { try { process.kill(pid, 0); return true; } catch { return false; } };
+  assert(alive(), "ccomm-web died during the tests above");
+  process.kill(pid, "SIGTERM");
+  await until(() => !alive(), 5000, "ccomm-web stopped by SIGTERM");
+  await until(() => page2.evaluate(() => document.querySelector("#conn").textContent !== "connected"), 5000, "page sees the server gone");
+  restarted = spawn(env("CCOMM"), ["--node", NODE, "web", "--port", new URL(WS_URL).port, "--http-port", new URL(WEB_URL).port],
+                    { stdio: ["ignore", "inherit", "inherit"] });
+  await until(() => page2.evaluate(() => document.querySelector("#conn").textContent === "connected"), 15000, "page reconnected");
+  pub("wheel_pos", 42.5);
+  await until(async () => (await domRow(page2, "wheel_pos")).value === "42.5", 5000, "a new value after the reconnect");
+});
+if (restarted) restarted.kill("SIGTERM");
+
 probe.close();
 if (browser2) await browser2.close();
 if (browser && browser.isConnected()) await browser.close().catch(() => {});

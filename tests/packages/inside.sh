@@ -74,6 +74,10 @@ kill -TERM "$daemon"
 wait "$daemon"
 stopped=$?
 check "ccommd stops cleanly on SIGTERM (exit 0)" test "$stopped" -eq 0
+check "python3-ccomm: a write while ccommd is down tells the caller" \
+  python3 "$T/talk.py" --version "$CCOMM_VERSION" --library-under / --base 10 --daemon-stopped
+check "the wheel: a write while ccommd is down tells the caller" bash -c \
+  "cd / && $T/venv/bin/python $T/talk.py --version $CCOMM_VERSION --library-under / --base 10 --daemon-stopped"
 check "apt purge removes the packages" \
   apt-get purge -y -q -o Debug::NoLocking=1 ccommd libccomm0 libccomm-dev python3-ccomm
 check "nothing of ccommd left but the user" bash -c "! test -e /etc/ccomm/signals.xml && ! test -e /usr/bin/ccommd"

@@ -30,7 +30,18 @@ def main() -> None:
     ap.add_argument("--library-under", required=True, action="append",
                     help="libccomm must be loaded from below this directory (repeatable)")
     ap.add_argument("--base", type=float, required=True, help="joint_pos[0] the C writer wrote")
+    ap.add_argument("--daemon-stopped", action="store_true",
+                    help="ccommd was stopped: a write must raise DaemonNotRunningError")
     a = ap.parse_args()
+    if a.daemon_stopped:
+        with ccomm.Client("robot") as c:  # the segment outlives ccommd
+            check("ccommd reported down", not c.daemon_alive)
+            try:
+                c.write("drive_ok", False)
+                check("a write while ccommd is down raises DaemonNotRunningError", False)
+            except ccomm.DaemonNotRunningError as e:
+                check(f"a write while ccommd is down says so: {e}", True)
+        return
 
     check("__version__", ccomm.__version__ == a.version == importlib.metadata.version("ccomm"),
           (ccomm.__version__, importlib.metadata.version("ccomm")))

@@ -8,7 +8,8 @@
  *
  *   latency_probe ccomm SIGNAL N SECONDS      ccomm reader (ccomm_wait, as an app would)
  *   latency_probe dds TOPIC N SECONDS         DDS reader of std_msgs/Float64MultiArray
- *   latency_probe dds-write TOPIC N HZ        bare DDS writer, the floor of the DDS leg
+ *   latency_probe dds-write TOPIC N HZ        bare DDS writer, the floor of the DDS leg;
+ *                                             prints its CPU time per sample
  *
  * Readers print one JSON line: {"n":..,"p50_us":..,"p90_us":..,"p99_us":..,"max_us":..}.
  */
@@ -17,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 
 #include "std_msgs.h"
@@ -115,6 +117,8 @@ static int dds_write_mode(const char* topic, long n, double hz) {
   s.layout_.dim_._length = s.layout_.dim_._maximum = 1;
   s.data_._buffer = data;
   s.data_._length = s.data_._maximum = COUNT;
+  struct rusage ru0, ru;
+  getrusage(RUSAGE_SELF, &ru0); /* after discovery: only the writing is counted, as for the bridge */
   int64_t period = (int64_t)(1e9 / hz), next = mono();
   for (long k = 1; k <= n; ++k) {
     struct timespec ts = {(time_t)(next / 1000000000), (long)(next % 1000000000)};
@@ -126,6 +130,11 @@ static int dds_write_mode(const char* topic, long n, double hz) {
     dds_write(wr, &s);
   }
   nanosleep(&settle, NULL);
+  /* CPU time of the whole writer process (its DDS threads too), as for the bridge */
+  getrusage(RUSAGE_SELF, &ru);
+#define US(t) ((double)(t).tv_sec * 1e6 + (double)(t).tv_usec)
+  double cpu_us = US(ru.ru_utime) + US(ru.ru_stime) - US(ru0.ru_utime) - US(ru0.ru_stime);
+  printf("{\"cpu_us_per_sample\":%.2f}\n", cpu_us / (double)n);
   dds_delete(pp);
   return 0;
 }

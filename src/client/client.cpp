@@ -47,6 +47,9 @@ struct HandleSignal {
   RingCursor cursor;         // event signals: this handle's position
   StateCache cache;
   uint64_t seen = 0;         // change counter at the last ccomm_wait()
+  uint8_t* pending = nullptr;   // CCOMM_OPEN_BATCH, state signals produced here: the value
+  uint64_t pending_ns = 0;      // written this step and its time, stored at the flush
+  bool has_pending = false;
 };
 
 struct ccomm_client {
@@ -60,6 +63,7 @@ struct ccomm_client {
   bool pending_tx = false;         // CCOMM_OPEN_BATCH: forwarded writes since the last flush
   uint64_t* pending_dirty = nullptr;  // CCOMM_OPEN_BATCH: their dirty bits, handed to ccommd at
                                       // the flush only (signal_count bits)
+  uint64_t* pending_states = nullptr; // CCOMM_OPEN_BATCH: state signals with a pending value
   bool pending_rx = false;         // CCOMM_OPEN_BATCH: any write since the last flush
 };
 
@@ -175,10 +179,14 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   for (uint32_t i = 0; i < n; ++i) {
     cache_total += CachedBytes(c->segment.dir(i));
     if (c->segment.safe_value(i)) cache_total += c->segment.dir(i).value_bytes;  // a private copy
+    const SignalDirectoryEntry& d = c->segment.dir(i);
+    if ((flags & CCOMM_OPEN_BATCH) && (d.flags & st::kSigProducedHere) && !(d.flags & st::kSigEvent))
+      cache_total += d.value_bytes;  // the step's pending value
   }
   c->cache_bytes = new (std::nothrow) uint8_t[cache_total ? cache_total : 1];
   c->pending_dirty = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
-  if (!c->sig || !c->cache_bytes || !c->pending_dirty) {
+  c->pending_states = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
+  if (!c->sig || !c->cache_bytes || !c->pending_dirty || !c->pending_states) {
     ccomm_close(c);
     return CCOMM_E_SYS;
   }
@@ -208,6 +216,10 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
       h.cache.value = c->cache_bytes + off;
       off += k;
     }
+    if ((flags & CCOMM_OPEN_BATCH) && (d.flags & st::kSigProducedHere) && !(d.flags & st::kSigEvent)) {
+      h.pending = c->cache_bytes + off;
+      off += d.value_bytes;
+    }
   }
   TakeChanges(c);  // ccomm_wait() waits for writes after the open
   ccomm::platform::ProcessId();  // fills the pid cache: the first write makes no syscall
@@ -221,6 +233,7 @@ void ccomm_close(ccomm_client* c) {
   delete[] c->sig;
   delete[] c->cache_bytes;
   delete[] c->pending_dirty;
+  delete[] c->pending_states;
   delete c;
 }
 
@@ -342,6 +355,20 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
   if (!(h->flags & st::kSigProducedHere)) return CCOMM_E_PERM;
   if (Retired(c)) return CCOMM_E_RETIRED;
   const uint64_t now = Now(c);
+  if (h->pending) {
+    // A batch step's state output is kept in the handle until ccomm_flush stores it with
+    // the step's other outputs: ccommd, woken by anyone, cannot send half a step or mix
+    // this step's value with the last step's (see PublishStep).
+    memcpy(h->pending, value, h->value_bytes);
+    h->pending_ns = now;
+    if (!h->has_pending) {
+      h->has_pending = true;
+      c->pending_states[static_cast<uint32_t>(s) / 64] |= 1ull << (static_cast<uint32_t>(s) % 64);
+    }
+    if ((h->flags & st::kSigForwarded) && !(h->flags & st::kSigPeriodic)) c->pending_tx = true;
+    c->pending_rx = true;
+    return 0;
+  }
   StoreResult r = (h->flags & st::kSigEvent) ? ccomm::store::RingWrite(h->ring, value, 0, now, now)
                                              : ccomm::store::StateWrite(h->state, value, 0, now, now);
   if (r != StoreResult::kOk) {
@@ -409,8 +436,37 @@ int ccomm_write_bool(ccomm_client* c, ccomm_signal s, int v) {
   return ccomm_write(c, s, &b, 1);
 }
 
+namespace {
+
+// The batch step: stores every pending state value (then marks them dirty with the step's
+// events, below). Bounded: signal_count / 64 words. Returns the first store error.
+int PublishStep(ccomm_client* c) {
+  int result = 0;
+  for (uint32_t w = 0; w < (c->signal_count + 63) / 64; ++w) {
+    uint64_t bits = c->pending_states[w];
+    c->pending_states[w] = 0;
+    while (bits) {
+      const uint32_t id = w * 64 + static_cast<uint32_t>(__builtin_ctzll(bits));
+      bits &= bits - 1;
+      HandleSignal& h = c->sig[id];
+      h.has_pending = false;
+      if (ccomm::store::StateWrite(h.state, h.pending, 0, h.pending_ns, h.pending_ns) != StoreResult::kOk) {
+        h.stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+        if (!result) result = CCOMM_E_BUSY;
+        continue;
+      }
+      h.stats->writes.fetch_add(1, std::memory_order_relaxed);
+      if ((h.flags & st::kSigForwarded) && !(h.flags & st::kSigPeriodic)) c->pending_dirty[w] |= 1ull << (id % 64);
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
 int ccomm_flush(ccomm_client* c) {
   if (!c) return CCOMM_E_INVAL;
+  const int stored = (c->flags & CCOMM_OPEN_BATCH) ? PublishStep(c) : 0;
   const bool quiet = (c->flags & CCOMM_OPEN_NO_DOORBELL) != 0;  // no syscall, even here
   if (c->pending_tx) {
     // Bounded: signal_count / 64 words (at most 64).
@@ -424,7 +480,7 @@ int ccomm_flush(ccomm_client* c) {
   }
   if (c->pending_rx && !quiet) ccomm::client::DoorbellNotifyRx(c->doorbell);
   c->pending_tx = c->pending_rx = false;
-  return 0;
+  return stored;
 }
 
 int ccomm_set_time(ccomm_client* c, int64_t t_ns) {

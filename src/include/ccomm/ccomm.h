@@ -62,8 +62,11 @@ typedef enum ccomm_status {
 
 /** ccomm_open flags */
 #define CCOMM_OPEN_NO_DOORBELL 0x1u /**< writes never make a syscall (see above) */
-#define CCOMM_OPEN_BATCH 0x2u       /**< writes only mark signals; ccomm_flush() sends them all
-                                         in one frame per destination (one doorbell per cycle) */
+#define CCOMM_OPEN_BATCH 0x2u       /**< a control step: state writes stay in the handle until
+                                         ccomm_flush() stores them all at once and sends them in
+                                         one frame per destination (one doorbell per cycle),
+                                         whatever other handles do meanwhile; events are queued at
+                                         once and leave with the flush */
 
 typedef struct ccomm_client ccomm_client;
 /** A signal handle (its id, the position in signals.xml); < 0 is invalid. */
@@ -131,9 +134,11 @@ CCOMM_API int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t le
 CCOMM_API int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len);
 
 /**
- * With CCOMM_OPEN_BATCH: hands every signal written since the last flush to ccommd at
- * once, so a control step's outputs travel in one frame. Call it at the end of each
- * cycle. Without the flag it does nothing. Real-time safe (same doorbell note).
+ * With CCOMM_OPEN_BATCH: stores every state value written since the last flush and hands
+ * them to ccommd at once, so a control step's outputs travel in one frame (reads see
+ * them from the flush on). Call it at the end of each cycle. Returns 0, or CCOMM_E_BUSY if
+ * a value could not be stored. Without the flag it does nothing. Real-time safe (same
+ * doorbell note).
  */
 CCOMM_API int ccomm_flush(ccomm_client* c);
 

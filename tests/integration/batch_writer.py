@@ -1,0 +1,37 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Control step for test_batch.py, through libccomm's C API (ctypes): a CCOMM_OPEN_BATCH
+handle writes bA, then a second, plain handle writes cC (its doorbell wakes ccommd in the
+middle of the step), then the batch handle writes bB and flushes. N cycles.
+
+    python3 batch_writer.py LIBCCOMM NODE CYCLES
+"""
+import ctypes
+import sys
+import time
+
+lib = ctypes.CDLL(sys.argv[1])
+node, cycles = sys.argv[2].encode(), int(sys.argv[3])
+lib.ccomm_write_double.argtypes = [ctypes.c_void_p, ctypes.c_int32, ctypes.c_double]
+lib.ccomm_flush.argtypes = [ctypes.c_void_p]
+lib.ccomm_find.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+
+
+def open_handle(flags):
+    h = ctypes.c_void_p()
+    r = lib.ccomm_open(node, ctypes.c_uint32(flags), ctypes.byref(h))
+    if r != 0:
+        sys.exit("ccomm_open: %d" % r)
+    return h
+
+
+batch, plain = open_handle(0x2), open_handle(0)  # CCOMM_OPEN_BATCH, default
+a, b, c = (lib.ccomm_find(batch, n) for n in (b"bA", b"bB", b"cC"))
+cc = lib.ccomm_find(plain, b"cC")
+for i in range(1, cycles + 1):
+    assert lib.ccomm_write_double(batch, a, float(i)) == 0
+    assert lib.ccomm_write_double(plain, cc, float(i)) == 0  # rings the doorbell now
+    time.sleep(0.0003)  # ccommd wakes and sends cC while the step is still open
+    assert lib.ccomm_write_double(batch, b, float(i)) == 0
+    assert lib.ccomm_flush(batch) == 0
+    time.sleep(0.0007)
+print("wrote", cycles)

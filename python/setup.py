@@ -6,11 +6,21 @@ Without the library this is the plain pure-Python build; metadata is in pyprojec
 from pathlib import Path
 
 from setuptools import setup
+from setuptools.dist import Distribution
 
 BUNDLED = Path(__file__).resolve().parent / "src" / "ccomm" / "_lib" / "libccomm.so.0"
 cmdclass = {}
+distclass = Distribution
 if BUNDLED.is_file():
     from wheel.bdist_wheel import bdist_wheel
+
+    class BinaryDistribution(Distribution):
+        """Native code inside: the files go to platlib, at the wheel's root."""
+
+        def has_ext_modules(self) -> bool:
+            return True
+
+    distclass = BinaryDistribution
 
     class PlatformWheel(bdist_wheel):  # type: ignore[misc]
         def finalize_options(self) -> None:
@@ -23,4 +33,4 @@ if BUNDLED.is_file():
 
     cmdclass["bdist_wheel"] = PlatformWheel
 
-setup(cmdclass=cmdclass)
+setup(cmdclass=cmdclass, distclass=distclass)

@@ -15,25 +15,20 @@ binary wheel, $CCOMM_BUILD_DIR/lib, the build directories of an enclosing source
 then the system (libccomm0).
 """
 from ._native import LibraryNotFoundError, find_library, library_path
-from .client import (
+from ._errors import (
     BusyError,
     CcommError,
-    Client,
     DaemonNotRunningError,
     InvalidArgumentError,
     NotFoundError,
     NotProducerError,
     QueueFullError,
-    Reading,
     RetiredError,
-    Signal,
-    SignalInfo,
-    SignalType,
-    Status,
     SystemCallError,
     TypeMismatchError,
     VersionError,
 )
+from .client import Client, Reading, Signal, SignalInfo, SignalType, Status
 
 # The one version of the Python package: pyproject.toml reads it, and scripts/package
 # checks that it equals the CMake project version and debian/changelog.

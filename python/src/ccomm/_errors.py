@@ -1,0 +1,69 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The exceptions of the ccomm package: one per ccomm error code, each also a subclass of
+the matching Python built-in where there is one."""
+from __future__ import annotations
+
+from . import _native
+
+
+class CcommError(Exception):
+    """A ccomm call failed; `code` is the ccomm error (< 0)."""
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+class InvalidArgumentError(CcommError, ValueError):
+    """CCOMM_E_INVAL: bad argument."""
+
+
+class NotFoundError(CcommError, LookupError):
+    """CCOMM_E_NOENT: no such signal, or no segment (is ccommd running?)."""
+
+
+class TypeMismatchError(CcommError, TypeError):
+    """CCOMM_E_TYPE: the value does not match the signal's type or size."""
+
+
+class NotProducerError(CcommError, PermissionError):
+    """CCOMM_E_PERM: this node does not produce the signal."""
+
+
+class QueueFullError(CcommError):
+    """CCOMM_E_FULL: the event queue is full (ccommd is not forwarding)."""
+
+
+class BusyError(CcommError):
+    """CCOMM_E_BUSY: writers raced for every slot; retry next cycle."""
+
+
+class SystemCallError(CcommError, OSError):
+    """CCOMM_E_SYS: an OS call failed at open."""
+
+
+class VersionError(CcommError):
+    """CCOMM_E_VERSION: the segment has another layout version than the library."""
+
+
+class RetiredError(CcommError):
+    """CCOMM_E_RETIRED: ccommd replaced the segment (new configuration): reopen."""
+
+
+class DaemonNotRunningError(CcommError, ConnectionError):
+    """A write reached shared memory but ccommd is not running (no heartbeat for a
+    second): nothing forwards the value to other nodes or judges its freshness there. A
+    restarted ccommd makes a new segment; this client then gets RetiredError."""
+
+
+_ERRORS = {-1: InvalidArgumentError, -2: NotFoundError, -3: TypeMismatchError,
+           -4: NotProducerError, -5: QueueFullError, -6: BusyError, -7: SystemCallError,
+           -8: VersionError, -9: RetiredError}
+
+
+def _check(code: int, what: str) -> int:
+    if code < 0:
+        msg = _native.lib().ccomm_strerror(code)
+        text = msg.decode() if msg else f"error {code}"
+        raise _ERRORS.get(code, CcommError)(code, f"{what}: {text}")
+    return code

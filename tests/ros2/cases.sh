@@ -165,5 +165,28 @@ check "  ... the bridge counted its reopens ($reopens)" bash -c "[[ $reopens -ge
 check "the bridge is still running after every DDS peer of this suite came and went" kill -0 "$BRIDGE_PID"
 errs=$(bridge_stat joints dds_errors)
 check "  ... without a DDS error ($errs)" bash -c "[[ $errs -eq 0 ]]"
+
+# ---- fuzzed DDS samples: every sample is written whole or refused whole, and counted
+fuzz_values=$(python3 -c '
+import json, random
+random.seed(2026)
+out = []
+for _ in range(200):
+    n = random.choice([0, 1, 2, 3, 3, 3, 4, 7, 64])
+    data = [random.uniform(-1e6, 1e6) for _ in range(n)]
+    count = random.choice([n, n, n, 3, 0, 5, 2**32 - 1])
+    out.append({"data": data, "count": count})
+print(json.dumps(out))')
+valid=$(python3 -c 'import json,sys; v=json.loads(sys.argv[1]); print(sum(1 for s in v if len(s["data"]) == 3 and s["count"] == 3))' "$fuzz_values")
+r0=$(bridge_stat setpoint received); w0=$(bridge_stat setpoint written); f0=$(bridge_stat setpoint refused_length)
+peer pub rt/ccomm/setpoint Float64MultiArray "$fuzz_values" --interval 0.003 >/dev/null
+r1=$(bridge_stat setpoint received); w1=$(bridge_stat setpoint written); f1=$(bridge_stat setpoint refused_length)
+figure "fuzzed samples: 200 sent ($valid well-formed), bridge received $((r1 - r0)), wrote $((w1 - w0)), refused $((f1 - f0))"
+check "fuzzed Float64MultiArray samples (random lengths and layouts): each written whole or refused and counted" \
+  bash -c "[[ $((r1 - r0)) -eq $((w1 - w0 + f1 - f0)) && $((w1 - w0)) -le $valid && $((f1 - f0)) -le $((200 - valid)) && $((r1 - r0)) -ge 190 ]]"
+check "  ... with no sample lost on this loopback: exactly the $valid well-formed ones written" \
+  bash -c "[[ $((r1 - r0)) -ne 200 || $((w1 - w0)) -eq $valid ]]"
+PATH=$BIN:$PATH "$BIN/ccomm" ros2 --help >"$WORK/cli-help" 2>&1
+check "'ccomm ros2' runs the bridge (ccomm-ros2 on PATH)" grep -q 'rt/NAMESPACE/SIGNAL' "$WORK/cli-help"
 kill -TERM "$BRIDGE_PID"; wait "$BRIDGE_PID"; rc=$?
 check "the bridge exits 0 on SIGTERM, printing its counters" bash -c "[[ $rc -eq 0 ]] && tail -1 '$BRIDGE_LOG' | grep -q '\"reopens\"'"

@@ -1,7 +1,9 @@
 #!/bin/bash
 # SPDX-License-Identifier: Apache-2.0
-# qemu-tests: both boards booted the image: systemd reached its target without failed
-# qemu-tests: units, each board has its name, its address and the real-time kernel.
+# qemu-tests: both boards booted the same image with the same signals.xml and no per-board
+# qemu-tests: name: systemd reached its target without failed units, each board has its
+# qemu-tests: address and the real-time kernel, and ccommd finds each board's node by its
+# qemu-tests: interface (ccommd --which-node); a file in which no node is the board is a clear error.
 # qemu-tests: timeout=120
 . "$(dirname "$0")/../lib/common.sh"
 
@@ -10,7 +12,9 @@ for b in $QT_BOARDS; do
 	mapfile -t f < <(vm "$b" 'hostname; systemctl is-system-running; ip -4 -o addr show dev eth0 | awk "{print \$4}";
 cat /sys/class/net/eth0/address; uname -rv; systemd-analyze 2>/dev/null | head -n1;
 systemctl --failed --no-legend --plain')
-	check "$b: hostname is $b (is '${f[0]}')" [ "${f[0]}" = "$b" ]
+	check "$b: the hostname does not name the board (one image for every board: '${f[0]}')" [ "${f[0]}" != "$b" ]
+	which=$(vm "$b" 'ccommd --which-node -c /etc/ccomm/signals.xml 2>&1')
+	check "$b: ccommd finds its node by the board's interface ($which)" eval "[[ \"\$which\" == '$b ('*'on eth0)' ]]"
 	check "$b: systemd state is running (is '${f[1]}')" [ "${f[1]}" = running ]
 	[ "${f[1]}" = running ] && [ ${#f[@]} -le 6 ] || printf '  failed unit: %s\n' "${f[@]:6}"
 	check "$b: eth0 has $(board_ip "$b")/24 (has '${f[2]}')" [ "${f[2]}" = "$(board_ip "$b")/24" ]
@@ -22,4 +26,11 @@ systemctl --failed --no-legend --plain')
 	fi
 	note "$b: ${f[5]}"
 done
+# A signals.xml in which no node has this board's address: ccommd says so and what it tried.
+b=${QT_BOARDS%% *}
+out=$(vm "$b" "sed 's/ip=\"10\.42\.0\./ip=\"10.42.9./' /etc/ccomm/signals.xml >/tmp/nomatch.xml;
+ccommd --which-node -c /tmp/nomatch.xml 2>&1; echo rc=\$?")
+note "$b: no node matches: $(head -c 300 <<<"$out")"
+check "$b: a file with no node for this board is refused, naming what was tried" \
+	eval "grep -q 'no node of /tmp/nomatch.xml is this board' <<<\"\$out\" && grep -q 'rc=1' <<<\"\$out\""
 finish

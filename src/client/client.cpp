@@ -158,13 +158,22 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
   *out = nullptr;
   char host[ccomm::store::kNameBytes];
   if (!node || !*node) node = getenv("CCOMM_NODE");
-  if (!node || !*node) {
+  const bool by_hostname = !node || !*node;
+  if (by_hostname) {
     if (!ccomm::platform::HostName(host, sizeof host)) return CCOMM_E_SYS;
     node = host;
   }
   auto* c = new (std::nothrow) ccomm_client();
   if (!c) return CCOMM_E_SYS;
   int r = c->segment.Open(ccomm::store::SegmentName(node));
+  if (r == -ENOENT && by_hostname) {
+    // One image for every board: the hostname need not name the node (ccommd found it
+    // by the board's MAC or IP). The board's only segment is its node's.
+    const std::string prefix = ccomm::store::SegmentName("");
+    char only[ccomm::store::kNameBytes];
+    if (ccomm::platform::ListShm(prefix.c_str() + 1, only, sizeof only) == 1)
+      r = c->segment.Open(ccomm::store::SegmentName(only));
+  }
   if (r == 0) r = ccomm::client::DoorbellOpen(c->segment, &c->doorbell);
   if (r != 0) {
     ccomm::client::DoorbellClose(c->doorbell);

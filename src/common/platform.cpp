@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/platform.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <linux/futex.h>
@@ -142,6 +143,19 @@ void SleepNs(uint64_t ns) {
   struct timespec ts = {static_cast<time_t>(ns / 1000000000ull), static_cast<long>(ns % 1000000000ull)};
   while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
   }
+}
+
+int ListShm(const char* prefix, char* first, size_t cap) {
+  DIR* d = opendir("/dev/shm");  // where glibc keeps POSIX shm objects
+  if (!d) return 0;
+  const size_t n = strlen(prefix);
+  int count = 0;
+  while (struct dirent* e = readdir(d)) {
+    if (strncmp(e->d_name, prefix, n) != 0 || !e->d_name[n] || strchr(e->d_name + n, '.')) continue;
+    if (count++ == 0 && cap) snprintf(first, cap, "%s", e->d_name + n);
+  }
+  closedir(d);
+  return count;
 }
 
 }  // namespace platform

@@ -61,6 +61,9 @@ void SleepNs(uint64_t ns);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 
+/// POSIX shm objects whose names start with `prefix` (without the leading '/'): how many,
+/// and the rest of the first one's name in `first` (`cap` bytes). Start-up only.
+int ListShm(const char* prefix, char* first, size_t cap);
 /// Hostname (for the default node name); false on error.
 bool HostName(char* buf, size_t cap);
 

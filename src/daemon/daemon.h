@@ -21,9 +21,10 @@ namespace ccomm {
 
 struct DaemonOptions {
   std::string config_path = "/etc/ccomm/signals.xml";
-  std::string node;            // empty = hostname
+  std::string node;            // empty = identify (node_identity.h)
   bool force_udp = false;      // --transport udp: ignore transport="raw" in the file
   bool check_only = false;
+  bool which_node = false;     // --which-node: print the node this board is and exit
   bool no_realtime = false;    // --no-rt: skip mlockall / SCHED_FIFO (tests, unprivileged)
   int verbosity = 6;           // LogLevel
   int recv_timeout_ms = 50;

@@ -15,6 +15,7 @@
 #include "common/platform.h"
 #include "config/config.h"
 #include "daemon/daemon.h"
+#include "daemon/node_identity.h"
 #include "daemon/privileges.h"
 #include "daemon/sd_notify.h"
 #include "store/layout.h"
@@ -32,7 +33,10 @@ const char kUsage[] =
     "Forward ccomm signals between this board's shared memory and the network.\n"
     "\n"
     "  -c, --config FILE     configuration (default /etc/ccomm/signals.xml)\n"
-    "  -n, --node NAME       this board's node in the file (default: $CCOMM_NODE, else hostname)\n"
+    "  -n, --node NAME       this board's node in the file (default: $CCOMM_NODE, else the\n"
+    "                        hostname if it names a node, else the node whose mac= or ip= is\n"
+    "                        on one of this board's interfaces: one image for every board)\n"
+    "      --which-node      print which node this board is, and how it was found; exit\n"
     "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
     "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
     "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
@@ -70,7 +74,8 @@ int main(int argc, char** argv) {
       {"check", optional_argument, nullptr, 'C'},  {"transport", required_argument, nullptr, 'T'},
       {"no-rt", no_argument, nullptr, 'R'},        {"verbose", no_argument, nullptr, 'v'},
       {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
-      {"version", no_argument, nullptr, 'V'},      {nullptr, 0, nullptr, 0}};
+      {"version", no_argument, nullptr, 'V'},      {"which-node", no_argument, nullptr, 'W'},
+      {nullptr, 0, nullptr, 0}};
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
     switch (ch) {
@@ -89,6 +94,7 @@ int main(int argc, char** argv) {
         }
         break;
       case 'R': opt.no_realtime = true; break;
+      case 'W': opt.which_node = true; break;
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
       case 'q': verbosity = 4; break;
       case 'h': fputs(kUsage, stdout); return 0;
@@ -116,22 +122,25 @@ int main(int argc, char** argv) {
            cfg.signals.size(), cfg.hash);
     return 0;
   }
-  if (opt.node.empty()) {
-    const char* env = getenv("CCOMM_NODE");
-    char host[64];
-    if (env && *env) opt.node = env;
-    else if (platform::HostName(host, sizeof host)) opt.node = host;
+  std::string explicit_from = "--node";
+  if (opt.node.empty() && getenv("CCOMM_NODE") && *getenv("CCOMM_NODE")) {
+    opt.node = getenv("CCOMM_NODE");
+    explicit_from = "$CCOMM_NODE";
   }
-  int node = cfg.FindNode(opt.node);
+  char host[64] = "";
+  if (!platform::HostName(host, sizeof host)) host[0] = '\0';
+  std::string how, node_error;
+  const int node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
   if (node < 0) {
-    std::string names;
-    for (const auto& n : cfg.nodes) names += (names.empty() ? "" : ", ") + n.name;
-    const char* from = getenv("CCOMM_NODE") && *getenv("CCOMM_NODE") && opt.node == getenv("CCOMM_NODE")
-                           ? "from $CCOMM_NODE" : "from --node or the hostname";
-    fprintf(stderr, "ccommd: %s has no node '%s' (%s; nodes: %s): pass --node NAME, set CCOMM_NODE, "
-            "or set the hostname\n", opt.config_path.c_str(), opt.node.c_str(), from, names.c_str());
+    fprintf(stderr, "ccommd: %s\n", node_error.c_str());
     return 1;
   }
+  if (opt.which_node) {
+    printf("%s (%s)\n", cfg.nodes[static_cast<size_t>(node)].name.c_str(), how.c_str());
+    return 0;
+  }
+  opt.node = cfg.nodes[static_cast<size_t>(node)].name;
+  Log(LogLevel::kInfo, "this board is node '%s' (%s)", opt.node.c_str(), how.c_str());
 
   // Signals are handled synchronously by the main thread; the I/O threads block them.
   sigset_t set;

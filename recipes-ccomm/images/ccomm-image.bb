@@ -17,14 +17,16 @@ IMAGE_INSTALL = "packagegroup-core-boot \
                  "
 IMAGE_LINGUAS = ""
 
-# ccommd and the CLI find their node in signals.xml by the hostname (unless --node or
-# $CCOMM_NODE say otherwise), so the image's hostname is the board's node. Build the
-# other board's image with CCOMM_NODE = "planner" (default signals.xml).
-CCOMM_NODE ?= "control"
+# One image for every board: ccommd finds its node in signals.xml by the hostname, else
+# by the board's MAC or IP (docs/yocto.md). Set CCOMM_NODE only to pin an image to one
+# board: it is then written to /etc/hostname.
+CCOMM_NODE ?= ""
 ROOTFS_POSTPROCESS_COMMAND += "ccomm_set_node"
-ccomm_set_node[doc] = "Write the board's ccomm node name (CCOMM_NODE) to /etc/hostname"
+ccomm_set_node[doc] = "Write CCOMM_NODE, if set, to /etc/hostname (the image then names its board)"
 ccomm_set_node() {
-    echo "${CCOMM_NODE}" > ${IMAGE_ROOTFS}${sysconfdir}/hostname
+    if [ -n "${CCOMM_NODE}" ]; then
+        echo "${CCOMM_NODE}" > ${IMAGE_ROOTFS}${sysconfdir}/hostname
+    fi
 }
 
 # testimage: lib/oeqa/runtime/cases/ccomm.py checks the service and a signal round trip

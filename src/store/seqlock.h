@@ -34,31 +34,28 @@ struct SlotMeta {
   uint64_t local_time_ns = 0;
 };
 
-/// The check of one copy (splitmix64 steps over meta and value words, zero-padded tail).
+/// The check of one copy: an odd-multiplier chain over meta and value words (zero-padded
+/// tail). Each step (xor a word, multiply by an odd constant) is a bijection of the running
+/// value, so a change to any one word always changes the check; random damage to several
+/// passes with probability ~2^-64. Cheap on purpose: it runs on every read of a new value.
 inline uint64_t CopyCheck(const SlotMeta& meta, const void* value, uint32_t value_bytes) {
-  auto mix = [](uint64_t x) {
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ull;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-  };
-  uint64_t h = mix(0x9e3779b97f4a7c15ull ^ meta.value_seq ^ (uint64_t{value_bytes} << 48));
-  h = mix(h ^ meta.source_time_ns);
-  h = mix(h ^ meta.local_time_ns);
+  constexpr uint64_t kOdd = 0x9e3779b97f4a7c15ull;
+  uint64_t h = (meta.value_seq ^ (uint64_t{value_bytes} << 48)) * kOdd;
+  h = (h ^ meta.source_time_ns) * kOdd;
+  h = (h ^ meta.local_time_ns) * kOdd;
   const uint8_t* p = static_cast<const uint8_t*>(value);
   uint32_t i = 0;
   for (; i + 8 <= value_bytes; i += 8) {
     uint64_t w;
     memcpy(&w, p + i, 8);
-    h = mix(h ^ w);
+    h = (h ^ w) * kOdd;
   }
   if (i < value_bytes) {
     uint64_t w = 0;
     memcpy(&w, p + i, value_bytes - i);
-    h = mix(h ^ w);
+    h = (h ^ w) * kOdd;
   }
-  return h;
+  return h ^ (h >> 31);
 }
 
 /// What a reader found in a copy.

@@ -8,8 +8,8 @@
   (common/), their own module and system headers;
 - their static libraries use no symbol that config, daemon or client define;
 - libccomm.so (the client library every application loads) carries no XML parser:
-  no RapidXML, no configuration parser, no config library symbol, and needs no library
-  beyond the C/C++ runtime.
+  no RapidXML, no configuration parser, no config library symbol, exports nothing but
+  the C API (ccomm_*), and needs no library beyond the C/C++ runtime.
 Exit 0 if all hold; 1 with one line per violation.
 """
 import os
@@ -83,6 +83,10 @@ def main():
     shared = sorted(s for s in config_syms & every if not s.startswith(("std::", "__", "operator", "typeinfo", "vtable")))
     for s in shared[:20]:
         errors.append("libccomm.so carries %s from libccomm_config.a" % s)
+    exported = nm(client_so, "-D", "--defined-only")
+    foreign = sorted(s for s in exported if not s.startswith("ccomm_") and not s.startswith(("_init", "_fini")))
+    for s in foreign[:20]:
+        errors.append("libccomm.so exports %s (only the C API, ccomm_*, is public)" % s)
     needed = subprocess.run(["readelf", "-d", client_so], stdout=subprocess.PIPE, text=True, check=True).stdout
     for lib in re.findall(r"\(NEEDED\).*\[(.+)\]", needed):
         if not re.match(r"lib(c|m|rt|pthread|dl|stdc\+\+|gcc_s|asan|ubsan|tsan)\.so", lib) and not lib.startswith("ld-linux"):

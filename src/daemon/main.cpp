@@ -130,7 +130,14 @@ int main(int argc, char** argv) {
   char host[64] = "";
   if (!platform::HostName(host, sizeof host)) host[0] = '\0';
   std::string how, node_error;
-  const int node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
+  int node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
+  // At boot the board's address may come a little after ccommd starts (DHCP): when the
+  // interfaces were to decide, look again for up to 10 s before giving up.
+  for (int tries = 0; node < 0 && opt.node.empty() && !opt.which_node && tries < 20; ++tries) {
+    if (tries == 0) Log(LogLevel::kNotice, "%s; waiting up to 10 s for the board's addresses", node_error.c_str());
+    platform::SleepNs(500ull * 1000 * 1000);
+    node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
+  }
   if (node < 0) {
     fprintf(stderr, "ccommd: %s\n", node_error.c_str());
     return 1;

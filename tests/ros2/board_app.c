@@ -3,7 +3,8 @@
  * board_app: the application on board A (or any node) in the ROS 2 bridge tests, a plain
  * client of the public ccomm C API.
  *
- *   board_app pub SIGNAL N HZ     write N values at HZ (0: as fast as the queue allows)
+ *   board_app pub SIGNAL N HZ     write N values at HZ (0: as fast as the queue allows),
+ *                                 never closer than half a period
  *   board_app watch SIGNAL N SEC  print the first N new values (state) / events within SEC
  *
  * Values are made so a reader can check each element and the write time: element 0 is
@@ -75,7 +76,14 @@ int main(int argc, char** argv) {
     int64_t period = arg > 0 ? (int64_t)(1e9 / arg) : 0, next = ccomm_now();
     long written = 0;
     for (long k = 1; k <= n; ++k) {
-      if (period) { sleep_until(next); next += period; }
+      if (period) {
+        sleep_until(next);
+        /* A late wake-up does not catch up with back-to-back writes: two values of a
+           state signal microseconds apart are a burst no reader can tell apart (last value
+           wins). Writes stay at least half a period apart, so the stream stays 1 kHz-like. */
+        int64_t now = ccomm_now();
+        next = next + period > now + period / 2 ? next + period : now + period / 2;
+      }
       int64_t t = ccomm_now();
       ccomm_set_time(c, t);  /* the value's ccomm write time is exactly t */
       fill(&d, (uint64_t)k, t, buf);

@@ -71,10 +71,10 @@ khz_run() {
   KHZ_LOSS=10000 KHZ_DDS_LOSS=-1 KHZ_REF_LOSS=0
   echo_start joints joints Float64MultiArray --count 10000 --timeout 16 --event || return 1
   # The reference: a plain ccomm app on B reading the same signal, at the bridge's priority.
-  in_ns planner env CCOMM_NODE=planner chrt -f 50 "$WORK/board_app" watch joints 10000 16 >"$WORK/joints.ref" &
+  fifo 50 ip netns exec "$NS_P" env CCOMM_NODE=planner "$WORK/board_app" watch joints 10000 16 >"$WORK/joints.ref" &
   local ref=$!
   sleep 0.2
-  in_ns control env CCOMM_NODE=control chrt -f 55 "$WORK/board_app" pub joints 10000 1000 >"$WORK/joints.app"
+  fifo 55 ip netns exec "$NS_C" env CCOMM_NODE=control "$WORK/board_app" pub joints 10000 1000 >"$WORK/joints.app"
   wait "$ECHO_PID"
   wait "$ref"
   pub1=$(bridge_stat joints published); skip1=$(bridge_stat joints skipped)

@@ -62,8 +62,7 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
                    help="uncompressed chunk size (default 1 MiB; chunks also close every second)")
     p.add_argument("--priority", type=int, default=0, metavar="N",
-                   help="SCHED_FIFO priority of the capture loop (the writer process gets 1; needs "
-                        "CAP_SYS_NICE); a state "
+                   help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); a state "
                         "value replaced before the loop reads it is missed (counted as a gap)")
     p.add_argument("--progress", choices=["auto", "lines", "none"], default="auto",
                    help="progress on stderr: in place on a terminal (auto), a line every 5 s, none")
@@ -139,8 +138,15 @@ def _write_some(fd: int, pending: bytearray) -> None:
     del pending[:n]
 
 
+class ReadDelay:
+    """How long values waited in the segment before the capture loop read them: a state
+    value that waits longer than its producer's period is replaced, and missed."""
+    max_ns = 0
+    over_1ms = 0
+
+
 def capture(h: Handle, sigs: List[SignalDesc], fd: int, duration: float, stop: List[int],
-            writer_alive: Callable[[], bool]) -> int:
+            writer_alive: Callable[[], bool], delay: ReadDelay) -> int:
     """Reads every new value of `sigs` until stopped; returns the exit status."""
     handle, read, wait, now, set_time = h.h, h.read, h.wait, h.now, h.set_time
     info = (ctypes.c_ubyte * struct.calcsize(INFO_FORMAT))()
@@ -174,6 +180,10 @@ def capture(h: Handle, sigs: List[SignalDesc], fd: int, duration: float, stop: L
                 status, flags, seq, age, src, lost = unpack_info(info)
                 if seq != last_seq[i]:
                     last_seq[i] = seq
+                    if age > delay.max_ns:
+                        delay.max_ns = age
+                    if age >= 1_000_000:
+                        delay.over_1ms += 1
                     out += pack(sid, status, flags, seq, t - age, src, lost)
                     out += view
                 if not event:
@@ -236,8 +246,10 @@ def record(a: argparse.Namespace) -> int:
     if pid == 0:
         os.close(wfd)
         code = 1
-        if a.priority > 0:  # above the machine's ordinary work, below the capture loop
-            _set_priority(1)
+        # The writer keeps the normal policy: it may use most of a core, and as a real-time
+        # task it would eat into the real-time budget of the CPU it shares with ccommd and
+        # the capture (the kernel throttles all of them when that runs out). It never
+        # delays the capture: values wait in the capture's memory when it falls behind.
         try:
             code = run_writer(rfd, opts)
         finally:
@@ -252,6 +264,7 @@ def record(a: argparse.Namespace) -> int:
     _set_priority(a.priority)
     gc.disable()  # the loop makes no cycles; a collection pause could miss a value
     ended: List[int] = []
+    delay = ReadDelay()
 
     def writer_alive() -> bool:
         if not ended:
@@ -261,7 +274,7 @@ def record(a: argparse.Namespace) -> int:
         return not ended
 
     try:
-        code = capture(h, sigs, wfd, a.duration, stop, writer_alive)
+        code = capture(h, sigs, wfd, a.duration, stop, writer_alive, delay)
     except BrokenPipeError:
         code = 1
     finally:
@@ -274,15 +287,17 @@ def record(a: argparse.Namespace) -> int:
         print(f"record: the writer process failed (exit {wcode}); see its message above",
               file=sys.stderr)
         return 1
-    _report_cpu(a)
+    _report_capture(a, delay)
     return code
 
 
-def _report_cpu(a: argparse.Namespace) -> None:
-    """CPU seconds of the capture loop and of the writer, into --stats-json."""
+def _report_capture(a: argparse.Namespace, delay: ReadDelay) -> None:
+    """CPU seconds of the capture loop and of the writer, and the read delays, into
+    --stats-json and on stderr."""
     me, child = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = {"cpu_capture_s": round(me.ru_utime + me.ru_stime, 3),
-           "cpu_writer_s": round(child.ru_utime + child.ru_stime, 3)}
+           "cpu_writer_s": round(child.ru_utime + child.ru_stime, 3),
+           "read_delay_max_ns": delay.max_ns, "reads_delayed_over_1ms": delay.over_1ms}
     if a.stats_json:
         try:
             with open(a.stats_json) as f:
@@ -293,8 +308,9 @@ def _report_cpu(a: argparse.Namespace) -> None:
         except (OSError, ValueError) as e:
             print(f"record: cannot update {a.stats_json}: {e}", file=sys.stderr)
     if a.progress != "none":
-        print(f"record: CPU time: capture {cpu['cpu_capture_s']} s, writer {cpu['cpu_writer_s']} s",
-              file=sys.stderr)
+        print(f"record: CPU time: capture {cpu['cpu_capture_s']} s, writer {cpu['cpu_writer_s']} s; "
+              f"values read up to {delay.max_ns / 1e6:.2f} ms after they arrived, "
+              f"{delay.over_1ms} of them 1 ms or more", file=sys.stderr)
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:

@@ -84,8 +84,7 @@ class Handle:
         r = L.ccomm_open(node.encode() if node else None, flags, ctypes.byref(h))
         if r != 0:
             where = f"node '{node}'" if node else "the default node ($CCOMM_NODE or the hostname)"
-            raise CcommCallError(r, f"cannot attach to {where}: {self.strerror(r)} "
-                                    "(is ccommd running for that node?)")
+            raise CcommCallError(r, f"cannot attach to {where}: {self.strerror(r)}")
         self.h: Optional[int] = h.value
         self.node = (L.ccomm_node_name(self.h) or b"").decode()
         # The loops' entry points, bound once.

@@ -93,6 +93,14 @@ struct Bridge {
   std::atomic<uint64_t> reopens{0};
   std::atomic<bool> stop{false};
   std::atomic<int> fatal{0};  // non-zero: exit status a worker asks for
+
+  Bridge() = default;
+  Bridge(const Bridge&) = delete;
+  Bridge& operator=(const Bridge&) = delete;
+  ~Bridge() {  // every exit path of main (usage errors, --list) frees the routes
+    for (Route* r : to_ros) delete r;
+    for (Route* r : from_ros) delete r;
+  }
 };
 
 // Opens the node's segment, waiting (with one message) while ccommd has not created it.

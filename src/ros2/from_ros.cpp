@@ -151,19 +151,21 @@ void RunFromRos(Bridge* b) {
     if (b->stop.load(std::memory_order_relaxed)) break;
     dds_waitset_wait(ws, nullptr, 0, DDS_MSECS(100));  // 100 ms to notice stop
     CheckPublications(b, builtin);
-    for (size_t i = 0; i < b->from_ros.size(); ++i) {
+    for (size_t i = 0; c && i < b->from_ros.size();) {
       bool p = pending[i] != 0;
       int err = Drain(b, c, b->from_ros[i], &p);
       pending[i] = p;
-      if (err == CCOMM_E_RETIRED || err == CCOMM_E_VERSION) {
-        if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: segment retired, reopening\n");
-        ccomm_close(c);
-        c = OpenWaiting(b);
-        if (!c) break;
-        if (!ResolveRoutes(b, c, b->from_ros)) { b->fatal = 1; b->stop = true; break; }
-        b->reopens.fetch_add(1, std::memory_order_relaxed);
-        --i;  // the same route again: its pending sample is written now
+      if (err != CCOMM_E_RETIRED && err != CCOMM_E_VERSION) {
+        ++i;
+        continue;
       }
+      // ccommd replaced the segment: attach anew, then the same route again (its pending
+      // sample is written into the new segment).
+      if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: segment retired, reopening\n");
+      ccomm_close(c);
+      c = OpenWaiting(b);
+      if (c && !ResolveRoutes(b, c, b->from_ros)) { b->fatal = 1; b->stop = true; break; }
+      if (c) b->reopens.fetch_add(1, std::memory_order_relaxed);
     }
   }
   if (c) ccomm_close(c);

@@ -215,7 +215,5 @@ int main(int argc, char** argv) {
   from_ros.join();
   PrintStats(&b);
   DestroyDdsEntities(&b);
-  for (std::vector<Route*>* list : {&b.to_ros, &b.from_ros})
-    for (Route* r : *list) delete r;
   return b.fatal.load();
 }

@@ -934,6 +934,14 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
     L.append("## 4. Cost\n")
     L.append(_cost_tables(R, meta) or "(not measured in this run)\n")
 
+    # Sections measured by other suites (system calls, ROS 2 bridge, recorder): each keeps
+    # its own file, docs/perf/sections/*.md, and is copied here as it is.
+    sections = os.path.join(doc_dir, "perf", "sections")
+    for name in sorted(os.listdir(sections)) if os.path.isdir(sections) else []:
+        if name.endswith(".md"):
+            text = open(os.path.join(sections, name), encoding="utf-8").read()
+            L.append("".join(l for l in text.splitlines(True) if not l.startswith("<!--")).rstrip() + "\n")
+
     L.append("## Plots\n")
     for p in pngs:
         rel = os.path.relpath(p, doc_dir)

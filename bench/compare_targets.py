@@ -17,7 +17,7 @@ import sys
 def targets(path):
     rows, seen, meta = [], {}, ""
     for line in open(path, encoding="utf-8"):
-        if line.startswith("Measured with `scripts/bench`"):
+        if line.startswith("Measured with `scripts/bench"):
             m = re.search(r"on (\S+) \(commit (\w+)\)", line)
             meta = "run of %s at commit %s" % m.groups() if m else line.strip()
         m = re.match(r"\| (.+?) \| \*\*(met|MISSED|reported|skipped)\*\* \| (.*) \|\s*$", line)

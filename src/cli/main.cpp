@@ -273,6 +273,15 @@ int RunExternal(const char* node, const char* cmd, int argc, char** argv) {
   args.push_back(nullptr);
   execvp(prog.c_str(), args.data());
   if (errno == ENOENT) {
+    // The tools that ship elsewhere say where they come from.
+    const char* hint = !strcmp(cmd, "ros2") ? "ccomm-ros2 is built when Cyclone DDS is found (Debian: cyclonedds-dev, cyclonedds-tools)"
+                       : (!strcmp(cmd, "record") || !strcmp(cmd, "replay")) ? "it comes with the Python package: pip install 'ccomm[record]'"
+                       : !strcmp(cmd, "web") ? "it comes with the Python package: pip install 'ccomm[web]'"
+                       : nullptr;
+    if (hint) {
+      fprintf(stderr, "ccomm: %s is not installed (no %s in PATH): %s\n", cmd, prog.c_str(), hint);
+      return 1;
+    }
     fprintf(stderr, "ccomm: unknown command '%s' (no %s in PATH)\n%s", cmd, prog.c_str(), kUsage);
     return 2;
   }

@@ -238,18 +238,6 @@ TEST(ReplayWindow, RebootedBoardOnlyAfterPlausibleSilence) {
 
 // ---- A real daemon on loopback UDP -------------------------------------------------
 
-uint16_t FreeUdpPort() {
-  int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  struct sockaddr_in sin = {};
-  sin.sin_family = AF_INET;
-  sin.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
-  socklen_t sl = sizeof sin;
-  getsockname(fd, reinterpret_cast<struct sockaddr*>(&sin), &sl);
-  close(fd);
-  return ntohs(sin.sin_port);
-}
-
 class DaemonAuthTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -259,7 +247,7 @@ class DaemonAuthTest : public ::testing::Test {
     auto sp = testing::MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
     cfg_ = testing::TwoNodeConfig({pos, sp});
     cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
-    cfg_.network.udp_port = FreeUdpPort();
+    cfg_.network.udp_port = testing::FreeUdpPort();
     tx_ = socket(AF_INET, SOCK_DGRAM, 0);
     // Frames claim node b: send them from b's configured address (receiver rule 2).
     struct sockaddr_in src = {};

@@ -22,18 +22,6 @@
 namespace ccomm {
 namespace {
 
-uint16_t FreeUdpPort() {
-  int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  struct sockaddr_in sin = {};
-  sin.sin_family = AF_INET;
-  sin.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
-  socklen_t sl = sizeof sin;
-  getsockname(fd, reinterpret_cast<struct sockaddr*>(&sin), &sl);
-  close(fd);
-  return ntohs(sin.sin_port);
-}
-
 constexpr uint16_t kStateId = 1, kEventId = 2;
 
 class RxRulesTest : public ::testing::Test {
@@ -47,7 +35,7 @@ class RxRulesTest : public ::testing::Test {
     ev.queue_depth = 64;
     cfg_ = testing::TwoNodeConfig({pos, sp, ev});
     cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
-    cfg_.network.udp_port = FreeUdpPort();
+    cfg_.network.udp_port = testing::FreeUdpPort();
     tx_ = Socket(cfg_.nodes[1].ip.c_str());
     to_.sin_family = AF_INET;
     to_.sin_port = htons(cfg_.network.udp_port);

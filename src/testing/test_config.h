@@ -3,6 +3,9 @@
 #pragma once
 
 #include <string>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include "config/config.h"
@@ -40,6 +43,19 @@ inline SystemConfig TwoNodeConfig(std::vector<SignalConfig> signals) {
 }
 
 /// A unique shm prefix per test process, so parallel test runs never share segments.
+/// A UDP port free on loopback right now (tests bind ccommd to it next).
+inline uint16_t FreeUdpPort() {
+  int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  struct sockaddr_in sin = {};
+  sin.sin_family = AF_INET;
+  sin.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
+  socklen_t sl = sizeof sin;
+  getsockname(fd, reinterpret_cast<struct sockaddr*>(&sin), &sl);
+  close(fd);
+  return ntohs(sin.sin_port);
+}
+
 inline std::string UniquePrefix(const char* tag) {
   return "/ccomm-test-" + std::string(tag) + "-" + std::to_string(getpid()) + ".";
 }

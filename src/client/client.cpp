@@ -451,6 +451,10 @@ namespace {
 // events, below). Bounded: signal_count / 64 words. Returns the first store error.
 int PublishStep(ccomm_client* c) {
   int result = 0;
+  bool any = false;
+  for (uint32_t w = 0; w < (c->signal_count + 63) / 64 && !any; ++w) any = c->pending_states[w] != 0;
+  if (!any) return 0;
+  c->segment.BeginStep();  // ccommd collecting meanwhile refreshes what it took (tx_path.cpp)
   for (uint32_t w = 0; w < (c->signal_count + 63) / 64; ++w) {
     uint64_t bits = c->pending_states[w];
     c->pending_states[w] = 0;
@@ -468,6 +472,7 @@ int PublishStep(ccomm_client* c) {
       if ((h.flags & st::kSigForwarded) && !(h.flags & st::kSigPeriodic)) c->pending_dirty[w] |= 1ull << (id % 64);
     }
   }
+  c->segment.EndStep();
   return result;
 }
 

@@ -87,6 +87,7 @@ class Daemon {
   };
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
+  void SettleSteps(uint32_t steps_before);
   void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
                 const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
@@ -121,6 +122,7 @@ class Daemon {
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
   std::vector<SignalRx> rx_seq_;                  // signal -> last value received (rule 6)
+  std::vector<uint32_t> collected_states_;        // state signals taken this send round
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here

@@ -84,6 +84,7 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
+  if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
   uint64_t& last = last_tx_seq_[id];
   if (!periodic && last && m.value_seq > last + 1)
     segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
@@ -91,6 +92,36 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 
+
+// A batch step stores its signals one after another; if one landed while this round was
+// collecting, the frames may hold some of its values and the previous step's others. So
+// the round waits for steps in progress (bounded), then brings every state value it took
+// up to date in the frames still open: a step's outputs leave together, whatever the
+// timing of ccommd against the writers. The common case costs two loads.
+void Daemon::SettleSteps(uint32_t steps_before) {
+  store::SegmentHeader* h = segment_.header();
+  for (int pass = 0; pass < 8; ++pass) {
+    for (int spin = 0; spin < 4096 && h->steps_active.load(std::memory_order_acquire) != 0; ++spin)
+      platform::CpuRelax();  // a flush stores a few values: microseconds
+    const uint32_t steps_now = h->steps_done.load(std::memory_order_acquire);
+    if (steps_now == steps_before) return;
+    steps_before = steps_now;
+    for (uint32_t id : collected_states_) {
+      store::StateView sv = segment_.state(id);
+      const uint64_t version = store::StateVersion(sv);
+      if (version == store::StateForwarded(sv)) continue;  // unchanged since it was taken
+      store::SlotMeta m;
+      if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) continue;
+      store::MarkStateForwarded(sv, version);
+      for (uint32_t peer : consumers_[id]) {
+        PeerTx& p = peers_tx_[peer];
+        if (p.open)
+          p.writer.Rewrite(static_cast<uint16_t>(id), static_cast<uint32_t>(m.value_seq), m.source_time_ns, tx_value_);
+      }
+      last_tx_seq_[id] = m.value_seq;
+    }
+  }
+}
 
 void Daemon::RunTx() {
   const NodeConfig& self = cfg_->nodes[self_];
@@ -104,6 +135,8 @@ void Daemon::RunTx() {
     tx_loops_.fetch_add(1, std::memory_order_relaxed);
     uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
     uint64_t now = platform::MonotonicNs();
+    const uint32_t steps_before = h->steps_done.load(std::memory_order_acquire);
+    collected_states_.clear();
     for (uint32_t w = 0; w < words; ++w) {
       uint64_t bits = dirty[w].exchange(0, std::memory_order_acq_rel);
       while (bits) {
@@ -115,6 +148,7 @@ void Daemon::RunTx() {
           CollectSignal(id, now, false);
       }
     }
+    SettleSteps(steps_before);
     // Idle, the loop wakes once per heartbeat (or more often if the service watchdog
     // needs it to advance sooner, see idle_sleep_ns_).
     uint64_t next_deadline = now + idle_sleep_ns_;

@@ -55,6 +55,11 @@ struct alignas(kCacheLine) SegmentHeader {
   // tx_doorbell and FUTEX_WAKE it only if ccommd said it is about to sleep.
   alignas(kCacheLine) std::atomic<uint32_t> tx_doorbell;
   std::atomic<uint32_t> tx_sleeping;
+  // Batch steps (CCOMM_OPEN_BATCH flushes) store several signals one after another:
+  // `steps_active` counts flushes storing right now, `steps_done` counts finished ones,
+  // so ccommd can tell that a step landed while it was collecting (tx_path.cpp).
+  std::atomic<uint32_t> steps_active;
+  std::atomic<uint32_t> steps_done;
   // Receive-side notification for ccomm_wait(), touched by writers only while someone
   // waits: a writer publishes (a seq_cst RMW on the signal: `latest` or `published`),
   // then loads rx_waiters; a waiter increments rx_waiters, then compares every signal's

@@ -66,6 +66,12 @@ class Segment {
   void MarkDirtyWord(uint32_t word, uint64_t bits) const {
     dirty_words()[word].fetch_or(bits, std::memory_order_release);
   }
+  /// A batch step's stores: between BeginStep and EndStep (see SegmentHeader::steps_active).
+  void BeginStep() const { header()->steps_active.fetch_add(1, std::memory_order_seq_cst); }
+  void EndStep() const {
+    header()->steps_done.fetch_add(1, std::memory_order_release);
+    header()->steps_active.fetch_sub(1, std::memory_order_release);
+  }
   /// Wakes ccommd's send thread if it sleeps (one FUTEX_WAKE only then).
   void RingTxDoorbell() const;
   /// MarkDirty, then bumps the doorbell, waking ccommd if `wake` (see layout.h).

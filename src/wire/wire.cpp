@@ -85,6 +85,30 @@ DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
   return DecodeError::kOk;
 }
 
+// Host-order elements to the wire's big-endian ones (bool: 0 or 1).
+void EncodeValue(uint8_t* v, const void* value, size_t esize, size_t count) {
+  const uint8_t* src = static_cast<const uint8_t*>(value);
+  switch (esize) {
+    case 1:  // bool: any non-zero host byte is true, the wire carries 0 or 1 only
+      for (size_t i = 0; i < count; ++i) v[i] = src[i] != 0 ? 1 : 0;
+      break;
+    case 4:
+      for (size_t i = 0; i < count; ++i) {
+        uint32_t x;
+        std::memcpy(&x, src + 4 * i, 4);
+        Store<uint32_t>(v + 4 * i, x);
+      }
+      break;
+    default:
+      for (size_t i = 0; i < count; ++i) {
+        uint64_t x;
+        std::memcpy(&x, src + 8 * i, 8);
+        Store<uint64_t>(v + 8 * i, x);
+      }
+      break;
+  }
+}
+
 }  // namespace
 
 const char* DecodeErrorName(DecodeError e) {
@@ -144,30 +168,28 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   Store<uint64_t>(p + kEOffTime, source_time_ns);
 
   uint8_t* v = p + kEntryHeaderSize;
-  const uint8_t* src = static_cast<const uint8_t*>(value);
-  switch (esize) {
-    case 1:  // bool: any non-zero host byte is true, the wire carries 0 or 1 only
-      for (size_t i = 0; i < count; ++i) v[i] = src[i] != 0 ? 1 : 0;
-      break;
-    case 4:
-      for (size_t i = 0; i < count; ++i) {
-        uint32_t x;
-        std::memcpy(&x, src + 4 * i, 4);
-        Store<uint32_t>(v + 4 * i, x);
-      }
-      break;
-    default:
-      for (size_t i = 0; i < count; ++i) {
-        uint64_t x;
-        std::memcpy(&x, src + 8 * i, 8);
-        Store<uint64_t>(v + 8 * i, x);
-      }
-      break;
-  }
+  EncodeValue(v, value, esize, count);
   std::memset(v + value_len, 0, Padded(value_len) - value_len);
   len_ += EntrySize(value_len);
   ++count_;
   return true;
+}
+
+bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value) {
+  if (len_ < kHeaderSize) return false;
+  size_t off = kHeaderSize;
+  for (uint16_t i = 0; i < count_; ++i) {  // bounded: the entries this writer added
+    uint8_t* p = buf_ + off;
+    const size_t value_len = Load<uint16_t>(p + kEOffLen);
+    if (Load<uint16_t>(p + kEOffSignal) == signal && !(p[kEOffFlags] & kEntryEvent)) {
+      Store<uint32_t>(p + kEOffSeq, seq);
+      Store<uint64_t>(p + kEOffTime, source_time_ns);
+      EncodeValue(p + kEntryHeaderSize, value, ValueTypeSize(p[kEOffType]), Load<uint16_t>(p + kEOffCount));
+      return true;
+    }
+    off += EntrySize(value_len);
+  }
+  return false;
 }
 
 size_t FrameWriter::Finish() {

@@ -77,6 +77,9 @@ class FrameWriter {
   /// frame is a heartbeat.
   bool Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
            uint64_t source_time_ns, const void* value, size_t value_len);
+  /// Replaces the value, seq and source time of the (non-event) entry of `signal` already
+  /// in this frame, re-encoded as Add does (same type and count). False if absent.
+  bool Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value);
   /// Writes entry_count / payload_len into the header; returns the frame length
   /// without any auth tag, or 0 if Begin failed (cap < kHeaderSize, unknown flag bits)
   /// or a frame without kFlagHeartbeat has no entry (such a frame is invalid).

@@ -32,6 +32,20 @@ def _sanitizer():
 SANITIZED = _sanitizer() != ""
 
 
+def python_env(env):
+    """`env` for a Python process that loads this build's libccomm through ctypes: a
+    sanitized library needs its runtime loaded first (python3 itself is not sanitized)."""
+    env = dict(env)
+    san = _sanitizer()
+    if san:
+        lib = {"address": "libasan.so", "thread": "libtsan.so"}[san]
+        path = subprocess.run(["c++", "-print-file-name=" + lib], capture_output=True, text=True).stdout.strip()
+        env["LD_PRELOAD"] = path
+        if san == "address":
+            env["ASAN_OPTIONS"] = "detect_leaks=0"  # the interpreter's own allocations
+    return env
+
+
 def run(cmd, check=True, **kw):
     return subprocess.run(cmd, check=check, capture_output=True, text=True, **kw)
 

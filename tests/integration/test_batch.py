@@ -9,7 +9,7 @@ import os
 import subprocess
 import time
 
-from harness import BUILD, NodePair, signal_stats
+from harness import BUILD, NodePair, python_env, signal_stats
 
 CONFIG = """<?xml version="1.0"?>
 <ccomm version="1">
@@ -36,7 +36,7 @@ def test_batch_step_leaves_in_one_frame(tmp_path):
         pair.start("control")
         writer = subprocess.run(pair.exec_prefix("control") + [
             "python3", os.path.join(HERE, "batch_writer.py"), os.path.join(BUILD, "lib", "libccomm.so"),
-            "control", str(CYCLES)], env=pair.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+            "control", str(CYCLES)], env=python_env(pair.env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
             timeout=120)
         assert writer.returncode == 0, writer.stdout
         sink.communicate(timeout=30)

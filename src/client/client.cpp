@@ -368,6 +368,15 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
     // A batch step's state output is kept in the handle until ccomm_flush stores it with
     // the step's other outputs: ccommd, woken by anyone, cannot send half a step or mix
     // this step's value with the last step's (see PublishStep).
+    if (h->has_pending) {
+      // The step writes this signal again: its earlier value is stored now, so that the
+      // newer one replacing it shows as a gap in the sequence (coalesced, as without
+      // batch), never as a value that silently did not exist.
+      if (ccomm::store::StateWrite(h->state, h->pending, 0, h->pending_ns, h->pending_ns) == StoreResult::kOk)
+        h->stats->writes.fetch_add(1, std::memory_order_relaxed);
+      else
+        h->stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+    }
     memcpy(h->pending, value, h->value_bytes);
     h->pending_ns = now;
     if (!h->has_pending) {

@@ -12,12 +12,13 @@ namespace ccomm {
 namespace {
 
 // Resynchronisation (docs/protocol.md, rules 5 and 6): this many consecutive frames of a
-// stream (values of a signal) that all look older than what was accepted mean the stored
-// position is wrong (a forged or corrupted frame jumped it far ahead, or the sender's
-// numbering restarted in a way the other rules could not see), not that the network
-// reorders this much: the receiver follows the incoming stream again. Genuine duplicates
-// and reordering never produce this many in a row without an in-order one between.
+// stream (values of a signal) that all lie more than kResyncDistance behind what was
+// accepted mean the stored position is wrong (a forged or corrupted frame jumped it far
+// ahead), not that the network reorders: the receiver follows the incoming stream again.
+// Reordering and jitter make frames late by tens of frames (netem.sh), never by a
+// thousand four times in a row; a frame only a little late is a reordered one.
 constexpr uint32_t kResyncAfter = 4;
+constexpr int32_t kResyncDistance = 1024;
 
 }  // namespace
 
@@ -38,9 +39,10 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
     // the meantime. (A frame that is merely late, even after a silence, was sent on an
     // older clock than that: it must not roll the values back.)
     resync = true;
-  } else if (++fs.behind >= kResyncAfter) {
+  } else if (d < -kResyncDistance && ++fs.behind >= kResyncAfter) {
     resync = true;  // the stored position is wrong (see kResyncAfter)
   } else {
+    if (d >= -kResyncDistance) fs.behind = 0;
     ps.frames_reordered.fetch_add(1, std::memory_order_relaxed);  // duplicate or late
     return;
   }
@@ -72,9 +74,10 @@ uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
     if (d > 1 && count_gaps)
       segment_.stats(id).lost.fetch_add(static_cast<uint32_t>(d) - 1, std::memory_order_relaxed);
     r.ext += static_cast<uint32_t>(d);
-  } else if (d < 0 && ++r.behind >= kResyncAfter) {
+  } else if (d < -kResyncDistance && ++r.behind >= kResyncAfter) {
     r.ext += 1;  // resynchronise (kResyncAfter); nothing counted lost
   } else {
+    if (d >= -kResyncDistance) r.behind = 0;
     // Older than what the signal has, or the same value again (a periodic signal's
     // re-send, a duplicate): not new, and a re-send never counts towards resync, so an
     // unchanged value still goes stale.

@@ -9,9 +9,11 @@
  *     (bounded retries), no allocation, no blocking, no syscall -- except that a write
  *     of a signal forwarded event-driven by ccommd rings a doorbell (one non-blocking
  *     FUTEX_WAKE) when the daemon is asleep, and any write wakes local ccomm_wait()
- *     callers (one FUTEX_WAKE) if there are any. Open with CCOMM_OPEN_NO_DOORBELL to make
- *     writes syscall-free (e.g. a Xenomai primary-mode thread); ccommd then sends at its
- *     periodic cycle or heartbeat instead of at once.
+ *     callers (one FUTEX_WAKE) if there are any. In the Xenomai build (CCOMM_WITH_XENOMAI)
+ *     that doorbell is a Cobalt XDDP send, no Linux syscall (docs/design.md, "Xenomai").
+ *     Open with CCOMM_OPEN_NO_DOORBELL to make writes syscall-free on plain Linux too;
+ *     ccommd then sends at its periodic cycle or heartbeat instead of at once. Measured
+ *     per call: docs/performance.md, "System calls per real-time call".
  *   - ccomm_wait blocks and is meant for non-real-time consumers.
  * Every read says whether the value is fresh, stale or was never received.
  * A handle is used by one thread at a time (event cursors live in it); open one handle

@@ -120,6 +120,17 @@ StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
 
 uint64_t Now(const ccomm_client* c) { return c->cycle_ns ? c->cycle_ns : ccomm::platform::MonotonicNs(); }
 
+// CCOMM_OPEN_BATCH: stores the value a step holds for `h` (stamped with its write time)
+// and counts the write or its failure. False if the store refused it.
+bool StorePending(HandleSignal& h) {
+  if (ccomm::store::StateWrite(h.state, h.pending, 0, h.pending_ns, h.pending_ns) != StoreResult::kOk) {
+    h.stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  h.stats->writes.fetch_add(1, std::memory_order_relaxed);
+  return true;
+}
+
 // Age of a value stored at `stored_ns` as seen at `now`: 0 if it arrived after `now`
 // (a cycle time taken before it arrived).
 int64_t Age(uint64_t now, uint64_t stored_ns) { return now > stored_ns ? static_cast<int64_t>(now - stored_ns) : 0; }
@@ -372,10 +383,7 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
       // The step writes this signal again: its earlier value is stored now, so that the
       // newer one replacing it shows as a gap in the sequence (coalesced, as without
       // batch), never as a value that silently did not exist.
-      if (ccomm::store::StateWrite(h->state, h->pending, 0, h->pending_ns, h->pending_ns) == StoreResult::kOk)
-        h->stats->writes.fetch_add(1, std::memory_order_relaxed);
-      else
-        h->stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+      StorePending(*h);
     }
     memcpy(h->pending, value, h->value_bytes);
     h->pending_ns = now;
@@ -472,12 +480,10 @@ int PublishStep(ccomm_client* c) {
       bits &= bits - 1;
       HandleSignal& h = c->sig[id];
       h.has_pending = false;
-      if (ccomm::store::StateWrite(h.state, h.pending, 0, h.pending_ns, h.pending_ns) != StoreResult::kOk) {
-        h.stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+      if (!StorePending(h)) {
         if (!result) result = CCOMM_E_BUSY;
         continue;
       }
-      h.stats->writes.fetch_add(1, std::memory_order_relaxed);
       if ((h.flags & st::kSigForwarded) && !(h.flags & st::kSigPeriodic)) c->pending_dirty[w] |= 1ull << (id % 64);
     }
   }

@@ -19,7 +19,7 @@ import sys
 MAGIC = 0x43434D57
 VERSION = 1
 F_HEARTBEAT, F_AUTH = 0x01, 0x02
-E_EVENT = 0x01
+E_EVENT, E_FRAGMENT = 0x01, 0x02
 
 # name: (code, element size, struct format)
 TYPES = {
@@ -63,6 +63,35 @@ class Entry:
             ([h(fmt, v) for v in self.values] + ([pad] if pad else []),
              "value %s%s" % (shown, "" if not pad else " + %d padding bytes%s"
                              % (len(pad), " (not zero)" if any(pad) else ""))),
+        ]
+
+
+class Fragment(Entry):
+    """A fragment entry: `values` are the part's elements, `whole` the value's count."""
+
+    def __init__(self, signal, tname, values, whole, offset, **kw):
+        Entry.__init__(self, signal, tname, values, **kw)
+        self.whole, self.offset = whole, offset
+
+    def lines(self):
+        code, size, fmt = TYPES[self.tname]
+        count = self.bad.get("count", self.whole)
+        value = b"".join(h(fmt, v) for v in self.values)
+        vlen = self.bad.get("value_len", len(value))
+        total = self.bad.get("total", self.whole * size)
+        pad = bytes(-len(value) % 8)
+        flags = self.flags | E_FRAGMENT
+        kind = "event" if self.flags & E_EVENT else "state"
+        head = [h("H", self.signal), h("B", code), h("B", flags), h("H", count),
+                h("H", vlen), h("I", self.seq), h("I", 0)]
+        shown = ", ".join(fmt_value(self.tname, v) for v in self.values)
+        return [
+            (head, "entry: signal %d, type %d (%s), flags %#04x (%s, fragment), count %d, value_len %d, seq %d, reserved 0x0"
+             % (self.signal, code, self.tname, flags, kind, count, vlen, self.seq)),
+            ([h("Q", self.time_ns)], "source_time_ns %d" % self.time_ns),
+            ([h("I", total), h("I", self.offset)], "fragment: total_len %d, offset %d" % (total, self.offset)),
+            ([h(fmt, v) for v in self.values] + ([pad] if pad else []),
+             "part %s%s" % (shown, "" if not pad else " + %d padding bytes" % len(pad))),
         ]
 
 
@@ -129,6 +158,9 @@ def vectors():
     ev = lambda **bad: Entry(7, "uint32", [17], flags=E_EVENT, seq=5, time_ns=2999999000, **bad)
     i32 = lambda **bad: Entry(1, "int32", [-1, 2, 300000], seq=1, time_ns=4999000000, **bad)
     boo = lambda **bad: Entry(0, "bool", [1], seq=1, time_ns=4999000000, **bad)
+    frag = lambda **bad: Fragment(10, "uint32", [398, 399], 400, bad.pop("offset", 1592), seq=11,
+                                  time_ns=2000150000, **bad)
+    fr = dict(sender=1, dest=2, config_hash=HASH, seq=44, time_ns=2000200000)
     hb = dict(sender=2, dest=0xFFFF, config_hash=HASH, seq=7, time_ns=1000000000, flags=F_HEARTBEAT)
     d = dict(sender=1, dest=2, config_hash=HASH, seq=42, time_ns=2000000500)
     e = dict(sender=3, dest=0, config_hash=HASH, seq=100, time_ns=3000000000)
@@ -148,6 +180,8 @@ def vectors():
         Frame("auth", "ok", sender=1, dest=2, config_hash=HASH, seq=43, time_ns=2000100000, flags=F_AUTH,
               entries=[Entry(9, "int64", [-2], seq=10, time_ns=2000000000)], tag=TAG,
               note="(e) frame with an authentication tag (here 00..0f; the codec does not check it)"),
+        Frame("fragment", "ok", entries=[frag()],
+              note="(f) fragment entry: the last part (elements 398 and 399) of a `uint32[400]` state value", **fr),
         # Malformed frames, each one field away from a valid one.
         Frame("short-header", "too_short", truncate=31, note="the heartbeat cut to 31 bytes", **hb),
         Frame("short-payload", "too_short", entries=[dbl()], truncate=56,
@@ -177,6 +211,15 @@ def vectors():
               note="last padding byte 1", **e),
         Frame("bool-two", "bad_entry", entries=[Entry(0, "bool", [2], seq=1, time_ns=4999000000)],
               note="bool value 2", **s),
+        Frame("fragment-total-mismatch", "bad_entry", entries=[frag(total=1604)],
+              note="fragment whose total_len is not count x element size (400 x 4 = 1600)", **fr),
+        Frame("fragment-past-total", "bad_entry", entries=[frag(offset=1596)],
+              note="fragment part running past the value's end (1596 + 8 > 1600)", **fr),
+        Frame("fragment-misaligned", "bad_entry", entries=[frag(offset=1590)],
+              note="fragment offset not a multiple of the element size", **fr),
+        Frame("fragment-whole-value", "bad_entry",
+              entries=[Fragment(10, "uint32", [398, 399], 2, 0, seq=11, time_ns=2000150000)],
+              note="fragment carrying the whole value (a value that fits is sent unfragmented)", **fr),
         Frame("trailing-byte", "trailing_bytes", trailing=b"\x00",
               note="the heartbeat plus one zero byte", **hb),
     ]

@@ -45,7 +45,8 @@ constexpr size_t kEOffSignal = 0, kEOffType = 2, kEOffFlags = 3, kEOffCount = 4,
                  kEOffSeq = 8, kEOffReserved = 12, kEOffTime = 16;
 
 constexpr uint8_t kKnownFrameFlags = kFlagHeartbeat | kFlagAuth;
-constexpr uint8_t kKnownEntryFlags = kEntryEvent;
+constexpr uint8_t kKnownEntryFlags = kEntryEvent | kEntryFragment;
+constexpr size_t kFOffTotal = kEntryHeaderSize, kFOffOffset = kEntryHeaderSize + 4;
 constexpr uint8_t kTypeBool = static_cast<uint8_t>(ValueType::kBool);
 
 inline size_t Padded(size_t n) { return (n + 7u) & ~size_t{7}; }
@@ -58,6 +59,18 @@ inline size_t DeclaredLength(const uint8_t* buf) {
   return total;
 }
 
+// Bytes before the value (or part) of the entry at `p`: 24, or 32 for a fragment.
+inline size_t ValueOffset(const uint8_t* p) {
+  return kEntryHeaderSize + ((p[kEOffFlags] & kEntryFragment) ? kFragmentHeaderSize : 0);
+}
+
+// The fragment rules of docs/protocol.md: a non-empty, element-aligned, strict part of a
+// value of count x esize <= kMaxFragmentedValue bytes.
+bool FragmentValid(size_t esize, size_t count, size_t part_len, size_t total, size_t offset) {
+  return total == count * esize && total <= kMaxFragmentedValue && part_len > 0 && part_len < total &&
+         part_len % esize == 0 && offset % esize == 0 && offset < total && part_len <= total - offset;
+}
+
 // Checks one entry at `p` with `left` payload bytes remaining; on success stores its wire
 // size in *size.
 DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
@@ -68,11 +81,19 @@ DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
   if (p[kEOffFlags] & ~kKnownEntryFlags) return DecodeError::kBadEntry;
   const size_t count = Load<uint16_t>(p + kEOffCount);
   const size_t value_len = Load<uint16_t>(p + kEOffLen);
-  if (count == 0 || value_len != count * esize) return DecodeError::kBadEntry;
+  if (count == 0) return DecodeError::kBadEntry;
   if (Load<uint32_t>(p + kEOffReserved) != 0) return DecodeError::kBadEntry;
-  const size_t total = kEntryHeaderSize + Padded(value_len);
+  const size_t head = ValueOffset(p);
+  if (head > left) return DecodeError::kBadEntry;
+  if (p[kEOffFlags] & kEntryFragment) {
+    if (!FragmentValid(esize, count, value_len, Load<uint32_t>(p + kFOffTotal), Load<uint32_t>(p + kFOffOffset)))
+      return DecodeError::kBadEntry;
+  } else if (value_len != count * esize) {
+    return DecodeError::kBadEntry;
+  }
+  const size_t total = head + Padded(value_len);
   if (total > left) return DecodeError::kBadEntry;
-  const uint8_t* v = p + kEntryHeaderSize;
+  const uint8_t* v = p + head;
   if (type == kTypeBool) {
     for (size_t i = 0; i < value_len; ++i) {
       if (v[i] > 1) return DecodeError::kBadEntry;
@@ -152,7 +173,7 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   if (count_ == UINT16_MAX) return false;
   const size_t esize = ValueTypeSize(type);
   if (esize == 0 || count == 0 || value_len != size_t{count} * esize) return false;
-  if ((flags & ~kKnownEntryFlags) != 0 || value == nullptr) return false;
+  if ((flags & ~kEntryEvent) != 0 || value == nullptr) return false;  // fragments: AddFragment
   // limit_ <= kMaxFrameSize, so value_len and the sizes below stay far from overflow
   // once this check passes.
   if (value_len > limit_ || EntrySize(value_len) > limit_ - len_) return false;
@@ -175,19 +196,49 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   return true;
 }
 
+bool FrameWriter::AddFragment(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
+                              uint64_t source_time_ns, uint32_t offset, const void* part, size_t part_len) {
+  if (len_ < kHeaderSize) return false;
+  if (buf_[kOffFlags] & kFlagHeartbeat) return false;
+  if (count_ == UINT16_MAX) return false;
+  const size_t esize = ValueTypeSize(type);
+  if (esize == 0 || count == 0 || (flags & ~kEntryEvent) != 0 || part == nullptr) return false;
+  if (part_len > limit_ || FragmentEntrySize(part_len) > limit_ - len_) return false;
+  const size_t total = size_t{count} * esize;
+  if (!FragmentValid(esize, count, part_len, total, offset)) return false;
+
+  uint8_t* p = buf_ + len_;
+  Store<uint16_t>(p + kEOffSignal, signal);
+  p[kEOffType] = type;
+  p[kEOffFlags] = static_cast<uint8_t>(flags | kEntryFragment);
+  Store<uint16_t>(p + kEOffCount, count);
+  Store<uint16_t>(p + kEOffLen, static_cast<uint16_t>(part_len));
+  Store<uint32_t>(p + kEOffSeq, seq);
+  Store<uint32_t>(p + kEOffReserved, 0);
+  Store<uint64_t>(p + kEOffTime, source_time_ns);
+  Store<uint32_t>(p + kFOffTotal, static_cast<uint32_t>(total));
+  Store<uint32_t>(p + kFOffOffset, offset);
+  uint8_t* v = p + kEntryHeaderSize + kFragmentHeaderSize;
+  EncodeValue(v, part, esize, part_len / esize);
+  std::memset(v + part_len, 0, Padded(part_len) - part_len);
+  len_ += FragmentEntrySize(part_len);
+  ++count_;
+  return true;
+}
+
 bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value) {
   if (len_ < kHeaderSize) return false;
   size_t off = kHeaderSize;
   for (uint16_t i = 0; i < count_; ++i) {  // bounded: the entries this writer added
     uint8_t* p = buf_ + off;
     const size_t value_len = Load<uint16_t>(p + kEOffLen);
-    if (Load<uint16_t>(p + kEOffSignal) == signal && !(p[kEOffFlags] & kEntryEvent)) {
+    if (Load<uint16_t>(p + kEOffSignal) == signal && !(p[kEOffFlags] & (kEntryEvent | kEntryFragment))) {
       Store<uint32_t>(p + kEOffSeq, seq);
       Store<uint64_t>(p + kEOffTime, source_time_ns);
       EncodeValue(p + kEntryHeaderSize, value, ValueTypeSize(p[kEOffType]), Load<uint16_t>(p + kEOffCount));
       return true;
     }
-    off += EntrySize(value_len);
+    off += ValueOffset(p) + Padded(value_len);
   }
   return false;
 }
@@ -263,8 +314,16 @@ bool EntryIterator::Next(EntryView* e) {
   e->value_len = Load<uint16_t>(p_ + kEOffLen);
   e->seq = Load<uint32_t>(p_ + kEOffSeq);
   e->source_time_ns = Load<uint64_t>(p_ + kEOffTime);
-  e->value = p_ + kEntryHeaderSize;
-  p_ += FrameWriter::EntrySize(e->value_len);
+  const size_t head = ValueOffset(p_);
+  if (e->flags & kEntryFragment) {
+    e->total_len = Load<uint32_t>(p_ + kFOffTotal);
+    e->offset = Load<uint32_t>(p_ + kFOffOffset);
+  } else {
+    e->total_len = e->value_len;
+    e->offset = 0;
+  }
+  e->value = p_ + head;
+  p_ += head + Padded(e->value_len);
   --left_;
   return true;
 }

@@ -26,8 +26,15 @@ enum FrameFlags : uint8_t {
 };
 
 enum EntryFlags : uint8_t {
-  kEntryEvent = 1u << 0,  // entry is an event (queued), not a state (last value wins)
+  kEntryEvent = 1u << 0,     // entry is an event (queued), not a state (last value wins)
+  kEntryFragment = 1u << 1,  // entry carries one part of a value too large for a frame
 };
+
+/// A fragment entry's sub-header (after the 24-byte entry header): the whole value's
+/// byte length (32 bits) and this part's byte offset in it (32 bits). See fragment.h.
+constexpr size_t kFragmentHeaderSize = 8;
+/// Largest value a fragment entry may belong to (the codec refuses a larger total).
+constexpr size_t kMaxFragmentedValue = 65536;
 
 struct FrameHeader {
   uint8_t version = kVersion;
@@ -52,7 +59,10 @@ struct EntryView {
   uint16_t value_len = 0;
   uint32_t seq = 0;
   uint64_t source_time_ns = 0;  // producer's CLOCK_MONOTONIC when the value was written
-  const uint8_t* value = nullptr;
+  const uint8_t* value = nullptr;  // value_len bytes (for a fragment: this part only)
+  // Fragment entries (flags & kEntryFragment) only; otherwise total_len == value_len, offset 0.
+  uint32_t total_len = 0;       // bytes of the whole value (count x element size)
+  uint32_t offset = 0;          // byte offset of this part in the whole value
 };
 
 enum class DecodeError : uint8_t {
@@ -77,6 +87,13 @@ class FrameWriter {
   /// frame is a heartbeat.
   bool Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
            uint64_t source_time_ns, const void* value, size_t value_len);
+  /// Appends a fragment entry: bytes [offset, offset + part_len) of a value of
+  /// total_len = count x element size bytes, `part` in host byte order. flags may hold
+  /// kEntryEvent (kEntryFragment is implied). Returns false (frame unchanged) if it would
+  /// not fit or the arguments break the rules of docs/protocol.md (element-aligned part
+  /// and offset, a strict part of the value, total at most kMaxFragmentedValue).
+  bool AddFragment(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
+                   uint64_t source_time_ns, uint32_t offset, const void* part, size_t part_len);
   /// Replaces the value, seq and source time of the (non-event) entry of `signal` already
   /// in this frame, re-encoded as Add does (same type and count). False if absent.
   bool Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value);
@@ -91,6 +108,19 @@ class FrameWriter {
   uint16_t entries() const { return count_; }
   /// Bytes an entry with value_len value bytes takes on the wire (padded to 8).
   static size_t EntrySize(size_t value_len) { return kEntryHeaderSize + ((value_len + 7u) & ~size_t{7}); }
+  /// Bytes a fragment entry with part_len part bytes takes on the wire.
+  static size_t FragmentEntrySize(size_t part_len) { return kFragmentHeaderSize + EntrySize(part_len); }
+  /// Whether a value_len-byte value fits one entry of a frame alone (else it travels in
+  /// fragments); `auth`: frames carry a tag.
+  static bool FitsOneFrame(size_t value_len, bool auth) {
+    return kHeaderSize + EntrySize(value_len) + (auth ? kAuthTagSize : 0) <= kMaxFrameSize;
+  }
+  /// Largest part of a fragment entry alone in a frame (a multiple of 8, so of every
+  /// element size): 1408 bytes, 1392 with a tag.
+  static size_t MaxFragmentPart(bool auth) {
+    return (kMaxFrameSize - kHeaderSize - kEntryHeaderSize - kFragmentHeaderSize - (auth ? kAuthTagSize : 0)) &
+           ~size_t{7};
+  }
 
  private:
   uint8_t* buf_;

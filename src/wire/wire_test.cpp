@@ -64,9 +64,22 @@ struct EntryDef {
   uint8_t flags;
   uint32_t seq;
   uint64_t time;
-  Bytes value;  // host order
-  uint16_t count() const { return static_cast<uint16_t>(value.size() / ElemSize(type)); }
+  Bytes value;  // host order (a fragment entry: its part only)
+  uint16_t whole_count = 0;  // fragment entries: elements of the whole value
+  uint32_t offset = 0;       // fragment entries: byte offset of the part
+  uint16_t count() const {
+    return (flags & kEntryFragment) ? whole_count : static_cast<uint16_t>(value.size() / ElemSize(type));
+  }
 };
+
+// FrameWriter::Add or AddFragment, as the entry's flags say.
+bool AddEntry(FrameWriter* w, uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
+              uint64_t time, uint32_t offset, const void* value, size_t len) {
+  if (flags & kEntryFragment)
+    return w->AddFragment(signal, type, static_cast<uint8_t>(flags & ~kEntryFragment), count, seq, time, offset,
+                          value, len);
+  return w->Add(signal, type, flags, count, seq, time, value, len);
+}
 
 struct FrameDef {
   FrameHeader h;
@@ -92,8 +105,8 @@ Bytes Encode(const FrameDef& f) {
   FrameWriter w(buf.data(), buf.size());
   w.Begin(f.h);
   for (const EntryDef& e : f.entries) {
-    EXPECT_TRUE(w.Add(e.signal, e.type, e.flags, e.count(), e.seq, e.time, e.value.data(),
-                      e.value.size()));
+    EXPECT_TRUE(AddEntry(&w, e.signal, e.type, e.flags, e.count(), e.seq, e.time, e.offset, e.value.data(),
+                         e.value.size()));
   }
   const size_t n = w.Finish();
   EXPECT_GT(n, 0u);
@@ -127,8 +140,10 @@ void ExpectDecodesTo(const Bytes& data, const FrameDef& f) {
     EXPECT_EQ(v.source_time_ns, e.time);
     ASSERT_GE(v.value, data.data());
     ASSERT_LE(v.value + v.value_len, data.data() + data.size());
+    EXPECT_EQ(v.offset, e.offset);
+    EXPECT_EQ(v.total_len, (e.flags & kEntryFragment) ? e.whole_count * ElemSize(e.type) : e.value.size());
     Bytes host(v.value_len);
-    ValueToHost(v.type, v.value, host.data(), v.count);
+    ValueToHost(v.type, v.value, host.data(), v.value_len / ElemSize(v.type));
     EXPECT_EQ(host, e.value) << "signal " << e.signal;
   }
   EXPECT_FALSE(it.Next(&v));
@@ -215,6 +230,9 @@ std::map<std::string, FrameDef> ValidVectors() {
   v["auth"] = {Header(kFlagAuth, 1, 43, 2000100000, 2),
                {{9, kInt64, 0, 10, 2000000000, HostBytes<int64_t>({-2})}},
                tag};
+  v["fragment"] = {Header(0, 1, 44, 2000200000, 2),
+                   {{10, kUint32, kEntryFragment, 11, 2000150000, HostBytes<uint32_t>({398, 399}), 400, 1592}},
+                   {}};
   return v;
 }
 
@@ -545,9 +563,9 @@ TEST(Bounds, SingleByteMutationsAreRejectedOrCanonical) {
         EntryView e;
         while (it.Next(&e)) {
           Bytes host(e.value_len);
-          ValueToHost(e.type, e.value, host.data(), e.count);
-          ASSERT_TRUE(w.Add(e.signal, e.type, e.flags, e.count, e.seq, e.source_time_ns,
-                            host.data(), host.size()));
+          ValueToHost(e.type, e.value, host.data(), e.value_len / ElemSize(e.type));
+          ASSERT_TRUE(AddEntry(&w, e.signal, e.type, e.flags, e.count, e.seq, e.source_time_ns, e.offset,
+                               host.data(), host.size()));
         }
         const size_t n = w.Finish();
         ASSERT_EQ(n, h.payload_len + kHeaderSize);

@@ -27,10 +27,11 @@ enum class TransportKind : uint8_t { kRaw = 0, kUdp = 1 };
 
 constexpr uint32_t kMaxSignals = 4096;
 constexpr uint32_t kMaxNodes = 64;
-constexpr uint32_t kMaxArrayCount = 1024;
+constexpr uint32_t kMaxArrayCount = 65535;  // the wire's 16-bit entry count
 constexpr uint32_t kMaxNameLength = 63;
-/// Largest value (count * element size) one signal may carry; it must fit in one frame.
-constexpr uint32_t kMaxValueBytes = 1024;
+/// Largest value (count * element size) one signal may carry (64 KiB). Values that do not
+/// fit one frame travel in fragments (docs/protocol.md, "Large values").
+constexpr uint32_t kMaxValueBytes = 65536;
 
 struct RealtimeConfig {
   bool mlockall = true;

@@ -446,10 +446,10 @@ struct EdgeCase {
 
 TEST(Parse, SignalAttributeEdgeCases) {
   const EdgeCase cases[] = {
-      {R"(type="bool" count="1024")", nullptr},
-      {R"(type="double" count="128")", nullptr},
-      {R"(type="double" count="129")", "1032 bytes"},
-      {R"(type="bool" count="1025")", "count 1025 out of range (expected 1..1024)"},
+      {R"(type="bool" count="65535")", nullptr},
+      {R"(type="double" count="8192")", nullptr},
+      {R"(type="double" count="8193")", "65544 bytes"},
+      {R"(type="bool" count="65536")", "count 65536 out of range (expected 1..65535)"},
       {R"(type="bool" count="0")", "count 0 out of range"},
       {R"(type="bool" count="-1")", "invalid count '-1'"},
       {R"(type="bool" count="4x")", "invalid count '4x'"},

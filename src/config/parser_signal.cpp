@@ -41,7 +41,7 @@ void Parser::SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs) {
         "signal value is " + std::to_string(sig->value_bytes()) + " bytes (count " +
             std::to_string(sig->count) + " x " + std::to_string(ValueTypeSize(sig->type)) +
             "-byte " + ValueTypeName(sig->type) + "); at most " + std::to_string(kMaxValueBytes) +
-            " fit in one frame");
+            " per signal");
     refs->ok = false;
   }
   bool kind_ok = true;

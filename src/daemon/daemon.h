@@ -15,6 +15,7 @@
 #include "daemon/transport.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
+#include "wire/fragment.h"
 #include "wire/wire.h"
 
 namespace ccomm {
@@ -99,6 +100,22 @@ class Daemon {
   uint64_t AcceptValue(uint32_t id, uint32_t seq, bool count_gaps);
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
+  // Large values (large_values.cpp): values that do not fit one frame.
+  struct LargeRx {
+    std::vector<uint8_t> buf;   // value_bytes, consumed large signals only
+    wire::Reassembler reasm;
+  };
+  struct LargePending {
+    uint32_t id;
+    bool periodic;
+  };
+  void InitLargeValues();
+  void SendLargeValues(uint64_t now);
+  void SendFragments(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
+                     const void* value, uint64_t now);
+  /// A fragment entry: true when it completed a value that was stored.
+  bool HandleFragment(const wire::FrameHeader& h, const wire::EntryView& e, uint64_t now);
+  void ResetReassemblers(uint32_t producer);
   void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
     segment_.header()->daemon_counters[c].fetch_add(1, order);
   }
@@ -133,6 +150,11 @@ class Daemon {
   bool wrong_hash_logged_ = false;
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
   uint64_t idle_sleep_ns_ = 0;  // longest sleep of an idle send loop
+  std::vector<uint8_t> large_;                    // signal -> travels in fragments
+  std::vector<LargeRx> large_rx_;                 // signal -> its reassembly (receive thread)
+  std::vector<LargePending> large_pending_;       // large values due this send round
+  bool sending_large_ = false;
+  bool large_refusal_logged_ = false;
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_buf_[2048];

@@ -53,6 +53,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
     // growing seq, see SignalRx).
     for (size_t i = 0; i < rx_seq_.size(); ++i)
       if (cfg_->signals[i].producer == h.sender) rx_seq_[i].seen = false;
+    ResetReassemblers(h.sender);
     fs.last_send_ns = h.send_time_ns;
   }
   fs.behind = 0;
@@ -150,6 +151,10 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     const SignalConfig& sc = cfg_->signals[e.signal];
     if (!(d.flags & store::kSigConsumedHere) || sc.producer != h.sender) {
       Count(store::kFramesNotForUs);
+      continue;
+    }
+    if (e.flags & wire::kEntryFragment) {  // part of a large value (large_values.cpp)
+      stored |= HandleFragment(h, e, now);
       continue;
     }
     bool is_event = (d.flags & store::kSigEvent) != 0;

@@ -45,6 +45,11 @@ void Daemon::FlushPeer(uint32_t peer) {
 
 void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
                       const store::SlotMeta& m, const void* value, uint64_t now) {
+  if (large_[id]) {
+    SendFragments(id, d, flags, m, value, now);
+    segment_.stats(id).tx.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   for (uint32_t peer : consumers_[id]) {
     PeerTx& p = peers_tx_[peer];
     for (int attempt = 0; attempt < 2; ++attempt) {
@@ -59,6 +64,10 @@ void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t
 }
 
 void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
+  if (large_[id] && !sending_large_) {  // sent after the round's small entries
+    large_pending_.push_back({id, periodic});
+    return;
+  }
   const store::SignalDirectoryEntry& d = segment_.dir(id);
   store::SlotMeta m;
   if (d.flags & store::kSigEvent) {
@@ -161,6 +170,7 @@ void Daemon::RunTx() {
       }
       if (due_ns_[id] < next_deadline) next_deadline = due_ns_[id];
     }
+    if (!large_pending_.empty()) SendLargeValues(now);
     for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
       PeerTx& pt = peers_tx_[p];
       if (!pt.active) continue;

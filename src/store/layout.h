@@ -168,6 +168,8 @@ struct alignas(kCacheLine) SignalStats {
   std::atomic<uint64_t> stale_transitions;  // fresh -> stale seen by ccommd's supervision
   std::atomic<uint64_t> last_rx_ns;
   std::atomic<uint64_t> corrupt;      // copies that failed their check (seqlock.h), by any reader
+  std::atomic<uint64_t> fragments_refused;  // large values: fragments refused as bad input
+  std::atomic<uint64_t> values_incomplete;  // large values: values given up for a missing fragment
 };
 static_assert(sizeof(SignalStats) == 2 * kCacheLine, "writer line + receive line");
 

@@ -81,10 +81,11 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
       const ccomm_signal_stats& ss = now.sigs[i];
       printf("%s{\"name\":\"%s\",\"writes\":%" PRIu64 ",\"write_errors\":%" PRIu64 ",\"tx\":%" PRIu64
              ",\"rx\":%" PRIu64 ",\"lost\":%" PRIu64 ",\"coalesced\":%" PRIu64 ",\"overflow\":%" PRIu64
-             ",\"stale_transitions\":%" PRIu64 ",\"corrupt\":%" PRIu64
-             ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
+             ",\"stale_transitions\":%" PRIu64 ",\"corrupt\":%" PRIu64 ",\"fragments_refused\":%" PRIu64
+             ",\"values_incomplete\":%" PRIu64 ",\"stale\":%s,\"rx_rate\":%.1f,\"tx_rate\":%.1f}",
              i ? "," : "", now.descs[i].name, ss.writes, ss.write_errors, ss.tx, ss.rx, ss.lost, ss.coalesced,
-             ss.overflow, ss.stale_transitions, ss.corrupt, ss.stale ? "true" : "false",
+             ss.overflow, ss.stale_transitions, ss.corrupt, ss.fragments_refused, ss.values_incomplete,
+             ss.stale ? "true" : "false",
              before ? Rate(before->sigs[i].rx, ss.rx, secs) : 0.0, before ? Rate(before->sigs[i].tx, ss.tx, secs) : 0.0);
     }
     printf("]}\n");
@@ -114,6 +115,12 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("%-24s %10" PRIu64 " %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %8" PRIu64 " %6s %6" PRIu64 " %8.0f %8.0f\n",
            d.name, ss.writes, ss.tx, ss.rx, ss.lost, ss.overflow, stale, ss.stale_transitions,
            before ? Rate(before->sigs[i].rx, ss.rx, secs) : 0.0, before ? Rate(before->sigs[i].tx, ss.tx, secs) : 0.0);
+  }
+  for (size_t i = 0; i < now.sigs.size(); ++i) {  // large values only, and only when it matters
+    const ccomm_signal_stats& ss = now.sigs[i];
+    if (ss.fragments_refused || ss.values_incomplete)
+      printf("%s: fragments_refused=%" PRIu64 " values_incomplete=%" PRIu64 "\n", now.descs[i].name,
+             ss.fragments_refused, ss.values_incomplete);
   }
   fflush(stdout);
 }

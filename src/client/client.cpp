@@ -567,6 +567,8 @@ int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_s
   out->overflow = ss.overflow.load(std::memory_order_relaxed);
   out->stale_transitions = ss.stale_transitions.load(std::memory_order_relaxed);
   out->corrupt = ss.corrupt.load(std::memory_order_relaxed);
+  out->fragments_refused = ss.fragments_refused.load(std::memory_order_relaxed);
+  out->values_incomplete = ss.values_incomplete.load(std::memory_order_relaxed);
   const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
   const uint64_t now = ccomm::platform::MonotonicNs();
   out->last_rx_age_ns = last ? Age(now, last) : -1;

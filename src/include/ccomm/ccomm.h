@@ -204,6 +204,8 @@ typedef struct ccomm_signal_stats {
   uint64_t corrupt;           /**< copies that failed their check (any reader, ccommd included) */
   int64_t last_rx_age_ns;     /**< age of the last received value; -1 if none */
   int32_t stale;              /**< consumed here with stale_after_ms, and older than that (or never) */
+  uint64_t fragments_refused; /**< values above one frame: fragments refused as bad input (duplicate, overlap...) */
+  uint64_t values_incomplete; /**< values above one frame: values given up for a missing fragment (also in `lost`) */
 } ccomm_signal_stats;
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or signal. */
 CCOMM_API int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out);

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# Large values under loss: control writes a 64 KiB uint32 array ("path", 47 fragments a
+# value) at 100 Hz to planner through tests/reliability/impair.c dropping BIGVALUE_LOSS %
+# of the frames (default 1: about 38% of the values lose a fragment). A reader on planner
+# checks every value it reads is whole (all elements equal the value's write number and
+# its seq: a mix of two values, or a value under the wrong seq, fails). Then the link is
+# cleaned and one last value written, and planner's counters must add up exactly:
+# rx + lost == values written, with lost > 0 and values_incomplete <= lost, no fragment
+# refused (loss is not bad input). Raw Ethernet, then UDP.
+#
+#   BIGVALUE_SECONDS (default 5): seconds of writing under loss per transport
+#   BIGVALUE_LOSS (default 1): percent of frames dropped
+source "$(dirname "$0")/lib.sh"
+require_root
+require_build
+build_tool impair
+build_tool bigvalue -I"$ROOT/src/include" -L"$BUILD/lib" -lccomm -Wl,-rpath,"$BUILD/lib"
+SECS=${BIGVALUE_SECONDS:-5}
+LOSS=${BIGVALUE_LOSS:-1}
+RATE=100
+COUNT=$((SECS * RATE))
+DAEMON_CONFIG=$WORK/bigvalue.xml
+
+imp_start() {
+  mkfifo "$WORK/imp.in"
+  ip netns exec "$NS_M" "$WORK/impair" --a m0 --b m1 --seed 11 <"$WORK/imp.in" >"$WORK/imp.out" 2>"$WORK/imp.err" &
+  PIDS+=($!)
+  exec 7>"$WORK/imp.in"
+  local i
+  for i in $(seq 100); do grep -q ready "$WORK/imp.out" && return 0; sleep 0.05; done
+  echo "Bail out! impair did not start: $(cat "$WORK/imp.err")"
+  exit 1
+}
+imp() {  # imp COMMAND: sends it, waits for the JSON line it prints, echoes that line
+  local n i
+  n=$(wc -l <"$WORK/imp.out")
+  echo "$*" >&7
+  for i in $(seq 200); do
+    (( $(wc -l <"$WORK/imp.out") > n )) && { tail -n1 "$WORK/imp.out"; return 0; }
+    sleep 0.01
+  done
+  echo "# impair did not answer '$*'" >&2
+  return 1
+}
+# sig NODE FIELD: a field of signal "path" from the last `stats NODE`
+sig() {
+  python3 -c 'import json,sys; s=[x for x in json.load(open(sys.argv[1]))["signals"] if x["name"]=="path"][0]
+print(s[sys.argv[2]])' "$WORK/stats-$1.json" "$2"
+}
+jfield() { python3 -c 'import json,sys; print(json.loads(sys.argv[1])[sys.argv[2]])' "$1" "$2"; }
+imp_dropped() { python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j["a2b"]["dropped"] + j["b2a"]["dropped"])' "$1"; }
+
+make_impaired_pair
+imp_start
+
+for transport in raw udp; do
+  sed "s/transport=\"raw\"/transport=\"$transport\"/" "$REL_DIR/bigvalue.xml" >"$DAEMON_CONFIG"
+  rm -f /dev/shm/"$TAG".* 2>/dev/null
+  start_daemon control || { not_ok "$transport: ccommd control starts"; continue; }
+  start_daemon planner || { not_ok "$transport: ccommd planner starts"; continue; }
+  imp "set loss=$LOSS" >/dev/null
+  imp_before=$(imp stats)
+
+  spawn "$WORK/reader-$transport.json" planner "$WORK/bigvalue" read planner path --duration $((SECS + 30))
+  READER=$!
+  w1=$(in_ns control "$WORK/bigvalue" write control path --first 1 --count "$COUNT" --rate $RATE)
+  sleep 0.2
+  imp "set loss=0" >/dev/null
+  # The last value crosses a clean link: every earlier one is then received or counted.
+  w2=$(in_ns control "$WORK/bigvalue" write control path --first $((COUNT + 1)) --count 1 --rate $RATE)
+  written=$(( $(jfield "$w1" written) + $(jfield "$w2" written) ))
+  for i in $(seq 100); do
+    stats planner
+    (( $(sig planner rx) + $(sig planner lost) >= written )) && break
+    sleep 0.05
+  done
+  imp_after=$(imp stats)
+  sleep 0.1
+  kill -TERM "$READER" 2>/dev/null
+  wait "$READER"
+  reader_rc=$?
+  reader=$(tail -n1 "$WORK/reader-$transport.json")
+  stats planner
+  stats control
+  rx=$(sig planner rx) lost=$(sig planner lost) inc=$(sig planner values_incomplete)
+  refused=$(sig planner fragments_refused)
+  dropped=$(( $(imp_dropped "$imp_after") - $(imp_dropped "$imp_before") ))
+  figure "bigvalue $transport: written=$written rx=$rx lost=$lost values_incomplete=$inc" \
+         "fragments_refused=$refused frames_dropped=$dropped reader=$reader"
+  check "$transport: reader saw only whole values (no torn or mismatched read)" test "$reader_rc" -eq 0
+  check "$transport: reader read values" test "$(jfield "$reader" distinct)" -gt 0
+  check "$transport: every value written was sent (tx == written)" test "$(sig control tx)" -eq "$written"
+  check "$transport: rx + lost == written exactly ($rx + $lost == $written)" test $((rx + lost)) -eq "$written"
+  check "$transport: loss happened (lost > 0, impair dropped $dropped frames)" test "$lost" -gt 0 -a "$dropped" -gt 0
+  check "$transport: values_incomplete <= lost ($inc <= $lost)" test "$inc" -le "$lost"
+  check "$transport: no value lost without a dropped frame ($lost <= $dropped)" test "$lost" -le "$dropped"
+  check "$transport: no fragment refused (losses are not bad input)" test "$refused" -eq 0
+  check "$transport: the last value arrived" test "$(jfield "$reader" last)" -eq "$written"
+  stop_daemon control
+  stop_daemon planner
+done
+finish

@@ -9,6 +9,7 @@ agrees with the document (and wire_test checks the C++ codec against the same te
   scripts/wire_vectors.py              check docs/protocol.md (exit 1 on any mismatch)
   scripts/wire_vectors.py --emit       print the vector blocks in the document's format
   scripts/wire_vectors.py --corpus DIR write every vector as a binary file (fuzz seeds)
+  scripts/wire_vectors.py --reassembly-corpus DIR   seeds of fuzz_reassembly (fragment streams)
 """
 import argparse
 import os
@@ -225,6 +226,34 @@ def vectors():
     ]
 
 
+def fragment_stream(count, values, part=1408, edit=None):
+    """fuzz_reassembly input: uint32[count], each value (seq, fill) split as ccommd does."""
+    frames = []
+    for seq, fill in values:
+        for off in range(0, count * 4, part):
+            n = min(part, count * 4 - off) // 4
+            frames.append(Frame("s", "ok", sender=1, dest=0, config_hash=HASH, seq=len(frames), time_ns=seq,
+                                entries=[Fragment(5, "uint32", [fill] * n, count, off, seq=seq, time_ns=seq)]).data())
+    if edit:
+        frames = edit(frames)
+    out = bytes([TYPES["uint32"][0] - 1]) + struct.pack(">H", count - 2)
+    return out + b"".join(struct.pack(">H", len(f)) + f for f in frames)
+
+
+def write_reassembly_corpus(d):
+    os.makedirs(d, exist_ok=True)
+    seeds = {
+        "in-order": fragment_stream(400, [(1, 7), (2, 8)]),
+        "small-parts": fragment_stream(16, [(1, 7), (2, 8)], part=16),
+        "duplicate": fragment_stream(400, [(1, 7), (2, 8)], edit=lambda f: f[:1] + f[:1] + f[1:]),
+        "gap": fragment_stream(1000, [(1, 7), (2, 8)], edit=lambda f: f[:1] + f[2:]),
+        "reordered": fragment_stream(1000, [(1, 7), (2, 8)], edit=lambda f: [f[1], f[0]] + f[2:]),
+    }
+    for name, data in seeds.items():
+        with open(os.path.join(d, name + ".bin"), "wb") as f:
+            f.write(data)
+
+
 def block(v):
     out = [v.note[0].upper() + v.note[1:] + ":"] if v.note else []
     out += ["```hex name=%s expect=%s" % (v.name, v.expect)]
@@ -255,6 +284,7 @@ def main():
     ap.add_argument("--doc", default=os.path.join(root, "docs", "protocol.md"))
     ap.add_argument("--emit", action="store_true")
     ap.add_argument("--corpus", metavar="DIR")
+    ap.add_argument("--reassembly-corpus", metavar="DIR")
     args = ap.parse_args()
     vs = vectors()
     if args.emit:
@@ -264,6 +294,9 @@ def main():
                 out.append("### Malformed frames")
             out.append(block(v))
         print("\n\n".join(out))
+        return 0
+    if args.reassembly_corpus:
+        write_reassembly_corpus(args.reassembly_corpus)
         return 0
     if args.corpus:
         # The vectors, plus inputs the fuzzer would take long to find by itself: the

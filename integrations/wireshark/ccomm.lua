@@ -19,7 +19,8 @@ local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16
 local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46
 local MAGIC, VERSION = 0x43434D57, 1
 local F_HEARTBEAT, F_AUTH, F_KNOWN = 0x01, 0x02, 0x03
-local E_EVENT, E_KNOWN = 0x01, 0x01
+local E_EVENT, E_FRAGMENT, E_KNOWN = 0x01, 0x02, 0x03
+local FRAGMENT_HEADER, MAX_FRAGMENTED = 8, 65536  -- fragment sub-header; largest fragmented value
 local DEST_ALL = 0xFFFF
 
 -- Builds with Lua 5.2 have bit32; with 5.3 or later, the operators instead (a syntax
@@ -59,7 +60,11 @@ local f = {
   e_type = ProtoField.uint8("ccomm.entry.type", "type", base.DEC, TYPE_NAMES),
   e_flags = ProtoField.uint8("ccomm.entry.flags", "flags", base.HEX),
   e_flag_event = ProtoField.bool("ccomm.entry.flags.event", "event (queued; clear: state)", 8, nil, E_EVENT),
-  e_flag_unknown = ProtoField.uint8("ccomm.entry.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFE),
+  e_flag_fragment = ProtoField.bool("ccomm.entry.flags.fragment", "fragment (part of a large value)", 8, nil,
+                                   E_FRAGMENT),
+  e_flag_unknown = ProtoField.uint8("ccomm.entry.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFC),
+  e_total_len = ProtoField.uint32("ccomm.entry.total_len", "total_len (whole value)", base.DEC),
+  e_offset = ProtoField.uint32("ccomm.entry.offset", "offset (of this part)", base.DEC),
   e_count = ProtoField.uint16("ccomm.entry.count", "count", base.DEC),
   e_value_len = ProtoField.uint16("ccomm.entry.value_len", "value_len", base.DEC),
   e_seq = ProtoField.uint32("ccomm.entry.seq", "seq", base.DEC),
@@ -218,8 +223,9 @@ local function all_zero(tvb, off, len)
 end
 
 -- Adds a well-formed value: ccomm.entry.value (all elements as text), under it one typed
--- item per element (ccomm.entry.value.double ...) for filters. Returns the text.
-local function add_value(tree, tvb, off, code, count, fail)
+-- item per element (ccomm.entry.value.double ...) for filters; a fragment's elements are
+-- numbered from `first`, their index in the whole value. Returns the text.
+local function add_value(tree, tvb, off, code, count, fail, first)
   local t = TYPES[code]
   local texts = {}
   for i = 0, count - 1 do
@@ -236,7 +242,8 @@ local function add_value(tree, tvb, off, code, count, fail)
   for i = 0, count - 1 do
     local r = tvb(off + i * t.size, t.size)
     local item = value_item:add(f["v_" .. t.name], r)
-    item:set_text(string.format("%s%s: %s", t.name, count > 1 and "[" .. i .. "]" or "", texts[i + 1]))
+    item:set_text(string.format("%s%s: %s", t.name, (count > 1 or first) and "[" .. (first or 0) + i .. "]" or "",
+                                texts[i + 1]))
     if code == 1 and r:uint() > 1 then fail(item, "a bool byte other than 0 or 1 (" .. r:uint() .. ")") end
   end
   return text
@@ -260,18 +267,21 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   local signal, code, eflags = tvb(off, 2):uint(), tvb(off + 2, 1):uint(), tvb(off + 3, 1):uint()
   local count, value_len = tvb(off + 4, 2):uint(), tvb(off + 6, 2):uint()
   local padded = value_len + (-value_len % 8)
-  local size = ENTRY_HEADER + padded
+  local frag = band(eflags, E_FRAGMENT) ~= 0
+  local head = ENTRY_HEADER + (frag and FRAGMENT_HEADER or 0)
+  local size = head + padded
   local sub = tree:add(f.entry, tvb(off, math.min(size, left, tvb:len() - off)))
   local sig = config.signals[signal]
   local t = TYPES[code]
-  sub:set_text(string.format("entry %d: signal %d%s, %s%s, %s, seq %d", index, signal,
+  sub:set_text(string.format("entry %d: signal %d%s, %s%s, %s%s, seq %d", index, signal,
     sig and " (" .. sig.name .. ")" or "", t and t.name or "type " .. code, count ~= 1 and "[" .. count .. "]" or "",
-    band(eflags, E_EVENT) ~= 0 and "event" or "state", tvb(off + 8, 4):uint()))
+    band(eflags, E_EVENT) ~= 0 and "event" or "state", frag and " fragment" or "", tvb(off + 8, 4):uint()))
   sub:add(f.e_signal, tvb(off, 2))
   if sig then sub:add(f.e_signal_name, tvb(off, 2), sig.name):set_generated() end
   local type_item = sub:add(f.e_type, tvb(off + 2, 1))
   local flags_item = sub:add(f.e_flags, tvb(off + 3, 1))
   flags_item:add(f.e_flag_event, tvb(off + 3, 1))
+  flags_item:add(f.e_flag_fragment, tvb(off + 3, 1))
   flags_item:add(f.e_flag_unknown, tvb(off + 3, 1))
   local count_item = sub:add(f.e_count, tvb(off + 4, 2))
   local len_item = sub:add(f.e_value_len, tvb(off + 6, 2))
@@ -285,24 +295,42 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   local function fail(item, text) ok = false; bad(item, text) end
   if not t then fail(type_item, "unknown type " .. code) end
   if band(eflags, 0xFF - E_KNOWN) ~= 0 then
-    fail(flags_item, string.format("unknown entry flag bits 0x%02x", band(eflags, 0xFE)))
+    fail(flags_item, string.format("unknown entry flag bits 0x%02x", band(eflags, 0xFC)))
   end
   if count == 0 then fail(count_item, "count 0") end
-  if t and count > 0 and value_len ~= count * t.size then
+  if tvb(off + 12, 4):uint() ~= 0 then fail(res_item, string.format("reserved not 0 (0x%08x)", tvb(off + 12, 4):uint())) end
+  if frag and left < head then
+    fail(sub, string.format("less than 32 bytes of payload left (%d)", left))
+    return nil
+  elseif frag and off + head <= tvb:len() then
+    local total, offset = tvb(off + 24, 4):uint(), tvb(off + 28, 4):uint()
+    local total_item = sub:add(f.e_total_len, tvb(off + 24, 4))
+    local offset_item = sub:add(f.e_offset, tvb(off + 28, 4))
+    sub:append_text(string.format(", bytes %d-%d of %d", offset, offset + value_len, total))
+    if t and (total ~= count * t.size or total > MAX_FRAGMENTED) then
+      fail(total_item, string.format("fragment total_len not count x element size, or above 65536 (%d)", total))
+    elseif t and (value_len == 0 or value_len % t.size ~= 0 or value_len >= total) then
+      fail(len_item, string.format("fragment part of 0 bytes, not a multiple of the element size, or not smaller than total_len (%d)", value_len))
+    elseif t and offset % t.size ~= 0 then
+      fail(offset_item, string.format("fragment offset not a multiple of the element size (%d)", offset))
+    elseif t and offset + value_len > total then
+      fail(offset_item, string.format("fragment part running past total_len (%d + %d > %d)", offset, value_len, total))
+    end
+  elseif t and count > 0 and value_len ~= count * t.size then
     fail(len_item, string.format("value_len %d not count x element size (%d x %d = %d)", value_len, count, t.size, count * t.size))
   end
-  if tvb(off + 12, 4):uint() ~= 0 then fail(res_item, string.format("reserved not 0 (0x%08x)", tvb(off + 12, 4):uint())) end
   if size > left then
     fail(sub, string.format("value and padding running past the payload (entry needs %d bytes, %d left)", size, left))
     return nil
   end
-  local voff = off + ENTRY_HEADER
+  local voff = off + head
   if voff + padded > math.min(ctx.flen, tvb:len()) then
     sub:add_proto_expert_info(E.note, "value " .. missing(voff + padded))
     return size
   end
   if ok then
-    sub:append_text(": " .. add_value(sub, tvb, voff, code, count, fail))
+    local first = frag and math.floor(tvb(off + 28, 4):uint() / t.size) or nil
+    sub:append_text(": " .. add_value(sub, tvb, voff, code, first and math.floor(value_len / t.size) or count, fail, first))
   elseif value_len > 0 then
     sub:add(f.e_value_bytes, tvb(voff, value_len))
   end

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "common/value_type.h"
 #include "wire/wire.h"
 
 using namespace ccomm::wire;
@@ -43,9 +44,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ++n;
     Check(e.value >= data && e.value + e.value_len <= data + len);
     Check(e.value_len <= sizeof g_host);
-    ValueToHost(e.type, e.value, g_host, e.count);
-    Check(w.Add(e.signal, e.type, e.flags, e.count, e.seq, e.source_time_ns, g_host,
-                e.value_len));
+    ValueToHost(e.type, e.value, g_host, e.value_len / ccomm::ValueTypeSize(e.type));
+    if (e.flags & kEntryFragment) {  // a part of a larger value: its own sub-header
+      Check(e.offset + e.value_len <= e.total_len && e.value_len < e.total_len);
+      Check(w.AddFragment(e.signal, e.type, static_cast<uint8_t>(e.flags & ~kEntryFragment), e.count, e.seq,
+                          e.source_time_ns, e.offset, g_host, e.value_len));
+    } else {
+      Check(w.Add(e.signal, e.type, e.flags, e.count, e.seq, e.source_time_ns, g_host, e.value_len));
+    }
   }
   Check(n == h.entry_count);
   const size_t out = w.Finish();

@@ -32,7 +32,7 @@ FIELDS = ["ccomm.magic", "ccomm.version", "ccomm.flags", "ccomm.sender", "ccomm.
           "ccomm.send_time_ns", "ccomm.entry_count", "ccomm.payload_len", "ccomm.dest", "ccomm.reserved",
           "ccomm.entry.signal", "ccomm.entry.type", "ccomm.entry.flags", "ccomm.entry.count",
           "ccomm.entry.value_len", "ccomm.entry.seq", "ccomm.entry.reserved", "ccomm.entry.source_time_ns",
-          "ccomm.entry.value", "ccomm.auth_tag", "ccomm.decode_error", "_ws.expert.message",
+          "ccomm.entry.value", "ccomm.entry.total_len", "ccomm.entry.offset", "ccomm.auth_tag", "ccomm.decode_error", "_ws.expert.message",
           "_ws.expert.severity", "_ws.malformed", "_ws.lua.text"] + \
          ["ccomm.entry.value." + t for t in TYPE_NAMES.values()]
 failures = []
@@ -80,8 +80,12 @@ def check_valid(pkt, v, where):
         return pkt.get(k, [])
     for k, want in (("ccomm.entry.signal", [str(e.signal) for e in v.entries]),
                     ("ccomm.entry.type", [str(wire_vectors.TYPES[e.tname][0]) for e in v.entries]),
-                    ("ccomm.entry.flags", ["0x%02x" % e.flags for e in v.entries]),
-                    ("ccomm.entry.count", [str(len(e.values)) for e in v.entries]),
+                    ("ccomm.entry.flags", ["0x%02x" % (e.flags | (wire_vectors.E_FRAGMENT if frag(e) else 0))
+                                           for e in v.entries]),
+                    ("ccomm.entry.count", [str(e.whole if frag(e) else len(e.values)) for e in v.entries]),
+                    ("ccomm.entry.total_len", [str(e.whole * wire_vectors.TYPES[e.tname][1]) for e in v.entries
+                                               if frag(e)]),
+                    ("ccomm.entry.offset", [str(e.offset) for e in v.entries if frag(e)]),
                     ("ccomm.entry.value_len", [str(len(e.values) * wire_vectors.TYPES[e.tname][1]) for e in v.entries]),
                     ("ccomm.entry.seq", [str(e.seq) for e in v.entries]),
                     ("ccomm.entry.reserved", ["0x00000000"] * n),
@@ -106,6 +110,10 @@ def check_valid(pkt, v, where):
             fail("%s: valid frame has expert info %s" % (where, pkt.get("_ws.expert.message")))
     if "ccomm.decode_error" in pkt or "_ws.malformed" in pkt or "_ws.lua.text" in pkt:
         fail("%s: valid frame flagged: %s %s" % (where, pkt.get("ccomm.decode_error"), pkt.get("_ws.lua.text")))
+
+
+def frag(e):
+    return isinstance(e, wire_vectors.Fragment)
 
 
 def same_value(tname, text, want, rel=0.0):

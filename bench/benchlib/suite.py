@@ -21,7 +21,7 @@ import shutil
 import time
 from dataclasses import dataclass, field
 
-from . import ccomm, floors, procs, results
+from . import ccomm, floors, large, procs, results
 from .ccomm import Daemons, Failed, Skip
 from .floors import Case
 
@@ -147,6 +147,12 @@ def plan(smoke=False, rates=None, scale=1.0):
         cases.append(CCase("thesis_%s_event_spin_10khz" % exp, "thesis", "thesis", SPIN_SECONDS,
                            {"exp": exp, "mode": "event", "rate": 10000, "style": "spin"}))
 
+    # ---- large values: 1 KiB (one frame) against 64 KiB (47 fragments), 100 Hz ----
+    for t in ("raw", "udp"):
+        for count in (128, 8192):
+            cases.append(CCase("large_%s_oneway_100hz_p%d" % (t, 8 * count), "large", "large", secs(4.0, 0.8),
+                               {"transport": t, "count": count, "rate": 100}))
+
     # ---- cost ----
     cases.append(CCase("cost_idle", "cost", "idle", secs(3.0, 0.5), {}))
     for exp in ("single", "setup"):
@@ -169,7 +175,7 @@ SMOKE_CASES = {
     "ccomm_raw_rtt_half_block_1khz_p8",
     "thesis_single_event_1khz", "thesis_setup_event_1khz", "thesis_setup_periodic_1khz",
     "thesis_setup_event_spin_10khz",
-    "cost_idle", "cost_callgrind_single", "cost_callgrind_client",
+    "cost_idle", "cost_callgrind_single", "cost_callgrind_client", "large_raw_oneway_100hz_p65536",
 }
 
 
@@ -676,5 +682,5 @@ def run_callgrind_client(ctx, case):
     return []
 
 
-RUNNERS = {"ccomm_local": run_local, "ccomm_pp": run_pingpong, "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle,
+RUNNERS = {"large": large.run_large, "ccomm_local": run_local, "ccomm_pp": run_pingpong, "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle,
            "callgrind": run_callgrind, "callgrind_client": run_callgrind_client}

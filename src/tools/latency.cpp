@@ -37,7 +37,9 @@ const char kUsage[] =
     "  -m, --mode MODE        oneway (default), ping, or echo (reply to a ping peer)\n"
     "      --send A,B,...     signals to write each cycle (default: doubles produced here)\n"
     "      --recv A,B,...     signals to wait for (default: doubles consumed here); event\n"
-    "                         signals named here are drained, the newest one counts\n"
+    "                         signals named here are drained, the newest one counts.\n"
+    "                         Named signals may be double arrays: every element carries k\n"
+    "                         (a read whose first and last elements differ is counted torn)\n"
     "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
     "      --prio N           SCHED_FIFO priority for both threads (needs CAP_SYS_NICE)\n"
     "      --rx-prio N        the receive thread's priority instead (e.g. below --prio with\n"
@@ -51,7 +53,7 @@ const char kUsage[] =
     "                         being the time since ccommd stored the newest value of the cycle\n"
     "                         on this node (so total - last hop = producer write -> ccommd here)\n"
     "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
-    "p999_ns,max_ns,mean_ns,count}.\n";
+    "p999_ns,max_ns,mean_ns,count,torn}.\n";
 
 struct Options {
   const char* node = nullptr;
@@ -88,6 +90,10 @@ struct Shared {
   ccomm_client* rx_client = nullptr;
   ccomm_client* tx_client = nullptr;
   std::vector<ccomm_signal> send, recv;
+  // Double arrays (count > 1): a buffer per signal, allocated before the loops; empty for
+  // a scalar, which takes the typed call.
+  std::vector<std::vector<double>> send_buf, recv_buf;
+  std::atomic<uint64_t> torn{0};
   std::vector<uint64_t> send_time;  // [k % kHistory]
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> sent{0};
@@ -100,8 +106,41 @@ struct Shared {
 };
 
 void WriteAll(Shared* s, double k) {
-  for (ccomm_signal id : s->send) ccomm_write_double(s->tx_client, id, k);
+  for (size_t i = 0; i < s->send.size(); ++i) {
+    std::vector<double>& b = s->send_buf[i];
+    if (b.empty()) {
+      ccomm_write_double(s->tx_client, s->send[i], k);
+    } else {
+      std::fill(b.begin(), b.end(), k);
+      ccomm_write(s->tx_client, s->send[i], b.data(), b.size() * sizeof(double));
+    }
+  }
   ccomm_flush(s->tx_client);
+}
+
+// Reads recv signal i (scalar or array) as one double: an array's first element, after
+// checking its last one agrees (ccomm delivers whole values only).
+int ReadRecv(Shared* s, size_t i, double* v, ccomm_info* info) {
+  std::vector<double>& b = s->recv_buf[i];
+  if (b.empty()) return ccomm_read_double(s->rx_client, s->recv[i], v, info);
+  const int r = ccomm_read(s->rx_client, s->recv[i], b.data(), b.size() * sizeof(double), info);
+  *v = b.front();
+  if ((r == CCOMM_FRESH || r == CCOMM_STALE) && b.back() != b.front()) s->torn.fetch_add(1);
+  return r;
+}
+
+// One buffer per signal of `ids`: empty for scalars, count doubles for a double array.
+std::vector<std::vector<double>> Buffers(ccomm_client* c, const std::vector<ccomm_signal>& ids) {
+  std::vector<std::vector<double>> out(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    ccomm_signal_desc d;
+    if (ccomm_describe(c, ids[i], &d) != 0 || d.type != CCOMM_DOUBLE) {
+      fprintf(stderr, "ccomm-latency: signal %d is not a double signal\n", ids[i]);
+      exit(2);
+    }
+    if (d.count > 1) out[i].assign(d.count, 0.0);
+  }
+  return out;
 }
 
 void* Receiver(void* arg) {
@@ -121,7 +160,7 @@ void* Receiver(void* arg) {
     double v;
     ccomm_info info;
     int r;
-    while ((r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info)) == CCOMM_FRESH || r == CCOMM_STALE) {
+    while ((r = ReadRecv(s, i, &v, &info)) == CCOMM_FRESH || r == CCOMM_STALE) {
       last_seq[i] = info.seq;
       if (!is_event[i]) break;
     }
@@ -147,7 +186,7 @@ void* Receiver(void* arg) {
       // just before the call gives the store time even if the call was preempted by
       // the very ccommd thread that stored the value.
       const uint64_t t_read = s->stages ? Now() : 0;
-      int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
+      int r = ReadRecv(s, i, &v, &info);
       // Events queue: take every one waiting, keep the newest (one wake-up may find
       // several, and leaving them queued would delay every later sample).
       while ((r == CCOMM_FRESH || r == CCOMM_STALE) && info.seq != last_seq[i]) {
@@ -157,7 +196,7 @@ void* Receiver(void* arg) {
         stored[i] = t_read - static_cast<uint64_t>(info.age_ns);
         changed = true;
         if (!is_event[i]) break;
-        r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
+        r = ReadRecv(s, i, &v, &info);
       }
     }
     if (!changed || n == 0) continue;
@@ -269,6 +308,8 @@ int main(int argc, char** argv) {
   }
   s.send = Resolve(s.tx_client, o.send, true, "--send");
   s.recv = Resolve(s.rx_client, o.recv, false, "--recv");
+  s.send_buf = Buffers(s.tx_client, s.send);
+  s.recv_buf = Buffers(s.rx_client, s.recv);
   s.ping = o.mode == "ping";
   s.echo = o.mode == "echo";
   s.spin = o.spin;
@@ -337,10 +378,10 @@ int main(int argc, char** argv) {
   printf("{\"label\":\"%s\",\"mode\":\"%s\",\"node\":\"%s\",\"rate_hz\":%.0f,\"send_signals\":%zu,"
          "\"recv_signals\":%zu,\"sent\":%" PRIu64 ",\"received\":%" PRIu64 ",\"lost\":%" PRIu64
          ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
-         ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu}\n",
+         ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu,\"torn\":%" PRIu64 "}\n",
          o.label.c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
          s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
-         v.empty() ? -1 : v.back(), mean, v.size());
+         v.empty() ? -1 : v.back(), mean, v.size(), s.torn.load());
   ccomm_close(s.tx_client);
   ccomm_close(s.rx_client);
   return 0;

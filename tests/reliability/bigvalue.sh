@@ -7,7 +7,8 @@
 # its seq: a mix of two values, or a value under the wrong seq, fails). Then the link is
 # cleaned and one last value written, and planner's counters must add up exactly:
 # rx + lost == values written, with lost > 0 and values_incomplete <= lost, no fragment
-# refused (loss is not bad input). Raw Ethernet, then UDP.
+# refused (loss is not bad input). Raw Ethernet, then UDP, each with unicast and with
+# multicast fan-out (fragments in the producer's group stream, dest 0xFFFF).
 #
 #   BIGVALUE_SECONDS (default 5): seconds of writing under loss per transport
 #   BIGVALUE_LOSS (default 1): percent of frames dropped
@@ -54,22 +55,29 @@ imp_dropped() { python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j[
 make_impaired_pair
 imp_start
 
-for transport in raw udp; do
-  sed "s/transport=\"raw\"/transport=\"$transport\"/" "$REL_DIR/bigvalue.xml" >"$DAEMON_CONFIG"
+for mode in raw udp raw-multicast udp-multicast; do
+  transport=${mode%%-*}
+  fanout=unicast
+  [[ $mode = *-multicast ]] && fanout=multicast
+  sed -e "s/transport=\"raw\"/transport=\"$transport\"/" -e "s/<network /<network fanout=\"$fanout\" /" \
+    "$REL_DIR/bigvalue.xml" >"$DAEMON_CONFIG"
   rm -f /dev/shm/"$TAG".* 2>/dev/null
-  start_daemon control || { not_ok "$transport: ccommd control starts"; continue; }
-  start_daemon planner || { not_ok "$transport: ccommd planner starts"; continue; }
+  start_daemon control || { not_ok "$mode: ccommd control starts"; continue; }
+  start_daemon planner || { not_ok "$mode: ccommd planner starts"; continue; }
+  spawn "$WORK/reader-$mode.json" planner "$WORK/bigvalue" read planner path --duration $((SECS + 30))
+  READER=$!
+  # The first value crosses a clean link: it is where the receiver starts counting
+  # (rule 6); nothing before it can be known lost.
+  w0=$(in_ns control "$WORK/bigvalue" write control path --first 1 --count 1 --rate $RATE)
+  sleep 0.2
   imp "set loss=$LOSS" >/dev/null
   imp_before=$(imp stats)
-
-  spawn "$WORK/reader-$transport.json" planner "$WORK/bigvalue" read planner path --duration $((SECS + 30))
-  READER=$!
-  w1=$(in_ns control "$WORK/bigvalue" write control path --first 1 --count "$COUNT" --rate $RATE)
+  w1=$(in_ns control "$WORK/bigvalue" write control path --first 2 --count "$COUNT" --rate $RATE)
   sleep 0.2
   imp "set loss=0" >/dev/null
-  # The last value crosses a clean link: every earlier one is then received or counted.
-  w2=$(in_ns control "$WORK/bigvalue" write control path --first $((COUNT + 1)) --count 1 --rate $RATE)
-  written=$(( $(jfield "$w1" written) + $(jfield "$w2" written) ))
+  # So does the last one: every value before it is then received or counted lost.
+  w2=$(in_ns control "$WORK/bigvalue" write control path --first $((COUNT + 2)) --count 1 --rate $RATE)
+  written=$(( $(jfield "$w0" written) + $(jfield "$w1" written) + $(jfield "$w2" written) ))
   for i in $(seq 100); do
     stats planner
     (( $(sig planner rx) + $(sig planner lost) >= written )) && break
@@ -80,23 +88,25 @@ for transport in raw udp; do
   kill -TERM "$READER" 2>/dev/null
   wait "$READER"
   reader_rc=$?
-  reader=$(tail -n1 "$WORK/reader-$transport.json")
+  reader=$(tail -n1 "$WORK/reader-$mode.json")
   stats planner
   stats control
   rx=$(sig planner rx) lost=$(sig planner lost) inc=$(sig planner values_incomplete)
   refused=$(sig planner fragments_refused)
   dropped=$(( $(imp_dropped "$imp_after") - $(imp_dropped "$imp_before") ))
-  figure "bigvalue $transport: written=$written rx=$rx lost=$lost values_incomplete=$inc" \
+  figure "bigvalue $mode: written=$written rx=$rx lost=$lost values_incomplete=$inc" \
          "fragments_refused=$refused frames_dropped=$dropped reader=$reader"
-  check "$transport: reader saw only whole values (no torn or mismatched read)" test "$reader_rc" -eq 0
-  check "$transport: reader read values" test "$(jfield "$reader" distinct)" -gt 0
-  check "$transport: every value written was sent (tx == written)" test "$(sig control tx)" -eq "$written"
-  check "$transport: rx + lost == written exactly ($rx + $lost == $written)" test $((rx + lost)) -eq "$written"
-  check "$transport: loss happened (lost > 0, impair dropped $dropped frames)" test "$lost" -gt 0 -a "$dropped" -gt 0
-  check "$transport: values_incomplete <= lost ($inc <= $lost)" test "$inc" -le "$lost"
-  check "$transport: no value lost without a dropped frame ($lost <= $dropped)" test "$lost" -le "$dropped"
-  check "$transport: no fragment refused (losses are not bad input)" test "$refused" -eq 0
-  check "$transport: the last value arrived" test "$(jfield "$reader" last)" -eq "$written"
+  check "$mode: reader saw only whole values (no torn or mismatched read)" test "$reader_rc" -eq 0
+  check "$mode: reader read values" test "$(jfield "$reader" distinct)" -gt 0
+  tx=$(sig control tx) coalesced=$(sig control coalesced)
+  check "$mode: every value written was sent or replaced before sending (tx $tx + coalesced $coalesced == $written)" \
+    test $((tx + coalesced)) -eq "$written"
+  check "$mode: rx + lost == written exactly ($rx + $lost == $written)" test $((rx + lost)) -eq "$written"
+  check "$mode: loss happened (lost > 0, impair dropped $dropped frames)" test "$lost" -gt 0 -a "$dropped" -gt 0
+  check "$mode: values_incomplete <= lost ($inc <= $lost)" test "$inc" -le "$lost"
+  check "$mode: no value lost without a dropped frame ($lost <= $dropped)" test "$lost" -le "$dropped"
+  check "$mode: no fragment refused (losses are not bad input)" test "$refused" -eq 0
+  check "$mode: the last value arrived" test "$(jfield "$reader" last)" -eq "$written"
   stop_daemon control
   stop_daemon planner
 done

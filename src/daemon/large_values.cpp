@@ -22,7 +22,8 @@ void Daemon::InitLargeValues() {
     if (d.flags & store::kSigConsumedHere) {
       LargeRx& l = large_rx_[id];
       l.buf.assign(d.value_bytes, 0);
-      l.reasm.Init(l.buf.data(), d.value_bytes);
+      // Periodic states are sent again unchanged each period: not duplicates.
+      l.reasm.Init(l.buf.data(), d.value_bytes, d.period_us != 0 && !(d.flags & store::kSigEvent));
     }
   }
   large_pending_.reserve(n);  // at most one entry per signal and round

@@ -21,7 +21,7 @@
 namespace ccomm {
 namespace {
 
-constexpr uint16_t kBigId = 1, kSmallId = 2;
+constexpr uint16_t kBigId = 1, kSmallId = 2, kPeriodicId = 3;
 constexpr uint32_t kElems = 16384;  // uint32[16384]: 64 KiB
 constexpr uint8_t kU32 = static_cast<uint8_t>(ValueType::kUint32);
 using Frame = std::vector<uint8_t>;
@@ -41,7 +41,9 @@ class LargeValuesTest : public ::testing::Test {
     auto pos = testing::MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
     auto big = testing::MakeSignal("big", ValueType::kUint32, kElems, SignalKind::kState, 1, {0});
     auto small = testing::MakeSignal("small", ValueType::kUint32, 4, SignalKind::kState, 1, {0});
-    cfg_ = testing::TwoNodeConfig({pos, big, small});
+    auto periodic = testing::MakeSignal("bigp", ValueType::kUint32, kElems, SignalKind::kState, 1, {0});
+    periodic.period_us = 10000;
+    cfg_ = testing::TwoNodeConfig({pos, big, small, periodic});
     cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
     cfg_.network.udp_port = testing::FreeUdpPort();
     tx_ = socket(AF_INET, SOCK_DGRAM, 0);
@@ -162,6 +164,23 @@ TEST_F(LargeValuesTest, LostFragmentLosesExactlyThatValue) {
   EXPECT_EQ(Stats(kBigId).values_incomplete.load(), 2u);
   EXPECT_EQ(Stats(kBigId).fragments_refused.load(), 0u) << "losses are not bad input";
   EXPECT_EQ(daemon_.segment().peer(1).frames_lost.load(), 0u) << "the test dropped fragments before numbering";
+}
+
+TEST_F(LargeValuesTest, PeriodicResendsAreNeitherRefusedNorNew) {
+  FrameOpts p;
+  p.signal = kPeriodicId;
+  auto v = Fragments(1, 5, 1000, p);
+  SendAll(v);
+  SendAll(v);  // the next period: the same value
+  auto cut = v;
+  cut.resize(20);
+  SendAll(cut);  // a period that lost its tail
+  SendAll(v);
+  EXPECT_EQ(Stats(kPeriodicId).rx.load(), 1u) << "one value, stored once";
+  EXPECT_EQ(Stats(kPeriodicId).fragments_refused.load(), 0u);
+  EXPECT_EQ(Stats(kPeriodicId).lost.load(), 0u);
+  SendAll(Fragments(2, 6, 2000, p));
+  EXPECT_EQ(Stats(kPeriodicId).rx.load(), 2u);
 }
 
 TEST_F(LargeValuesTest, BadFragmentsAreRefusedCountedAndNeverVisible) {

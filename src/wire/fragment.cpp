@@ -59,7 +59,7 @@ FragmentResult Reassembler::Accept(const EntryView& e, uint32_t* abandoned) {
   if (state_ == State::kIdle) {
     if (have_last_) {
       const int32_t d = static_cast<int32_t>(e.seq - last_seq_);
-      if (d == 0) return FragmentResult::kDuplicate;
+      if (d == 0) return resent_ && e.offset == 0 ? Start(e, abandoned) : FragmentResult::kDuplicate;
       if (d < 0 && d >= -kStaleDistance) return FragmentResult::kStale;
     }
     return Start(e, abandoned);
@@ -71,6 +71,9 @@ FragmentResult Reassembler::Accept(const EntryView& e, uint32_t* abandoned) {
     if (state_ == State::kAssembling) ++*abandoned;
     return Start(e, abandoned);
   }
+  // A periodic re-send of the same value starts over (the bytes are the same; an
+  // assembly in progress is not lost, it continues from the new first part).
+  if (resent_ && e.offset == 0) return Start(e, abandoned);
   if (state_ == State::kDiscarding) return FragmentResult::kLostValue;
 
   // Same value, in progress.

@@ -41,10 +41,14 @@ inline bool IsRefusal(FragmentResult r) { return r >= FragmentResult::kDuplicate
 class Reassembler {
  public:
   /// `buf` holds exactly `value_bytes` bytes (the signal's configured value size) and
-  /// receives the value in host byte order.
-  void Init(uint8_t* buf, uint32_t value_bytes) {
+  /// receives the value in host byte order. `resent`: the producer sends the same value
+  /// again (a periodic signal), so a first part of the value in progress or last
+  /// completed starts its assembly again instead of being refused as a duplicate (the
+  /// bytes are the same: one seq is one value).
+  void Init(uint8_t* buf, uint32_t value_bytes, bool resent = false) {
     buf_ = buf;
     cap_ = value_bytes;
+    resent_ = resent;
     Reset();
   }
   /// Forgets everything (the producer restarted: its sequence numbers start over).
@@ -74,6 +78,7 @@ class Reassembler {
 
   uint8_t* buf_ = nullptr;
   uint32_t cap_ = 0;
+  bool resent_ = false;
   State state_ = State::kIdle;
   uint32_t seq_ = 0;
   uint32_t next_ = 0;

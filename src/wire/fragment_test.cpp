@@ -237,6 +237,31 @@ TEST(Fragment, RestartedProducerStartsOver) {
   EXPECT_EQ(rx.completed, 3u);
 }
 
+TEST(Fragment, PeriodicResendsAreNotDuplicates) {
+  Rx rx;
+  rx.r.Init(rx.buf.data(), kBytes, /*resent=*/true);
+  auto a = Split(1, 1);
+  for (auto& f : a) rx.Feed(f);
+  for (auto& f : a) rx.Feed(f);  // the next period: the same value again
+  EXPECT_EQ(rx.completed, 2u);
+  EXPECT_EQ(rx.refused, 0u);
+  // A re-send that loses its tail, then the next re-send: it completes, nothing counted
+  // lost (the value itself did arrive).
+  for (size_t i = 0; i < 30; ++i) rx.Feed(a[i]);
+  for (auto& f : a) rx.Feed(f);
+  EXPECT_EQ(rx.completed, 3u);
+  EXPECT_EQ(rx.abandoned, 0u);
+  // Still refused: a middle part again, and an older value.
+  for (size_t i = 0; i < 5; ++i) rx.Feed(a[i]);
+  EXPECT_EQ(rx.Feed(a[2]), FragmentResult::kDuplicate);
+  for (size_t i = 5; i < a.size(); ++i) rx.Feed(a[i]);
+  auto b = Split(2, 2);
+  for (auto& f : b) rx.Feed(f);
+  EXPECT_EQ(rx.Feed(a[0]), FragmentResult::kStale);
+  EXPECT_EQ(rx.Fill(), 2u);
+  EXPECT_EQ(rx.completed, 5u);
+}
+
 TEST(Fragment, SequenceWrapsAround) {
   Rx rx;
   for (uint32_t seq : {0xFFFFFFFEu, 0xFFFFFFFFu, 0u, 1u}) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a stream of frames fed to one Reassembler, checked against a shadow
-// model. Input: type (1 byte), count (2 bytes, big-endian) of the signal, then frames,
+// model. Input: type (1 byte, high bit: the signal is periodic), count (2 bytes, big-endian) of the signal, then frames,
 // each as a 2-byte big-endian length and that many bytes. Every fragment entry of a
 // decodable frame with the signal's type and count goes to Accept(). Promises checked:
 // nothing outside a buffer is touched (ASan), a refused part changes nothing, and a value
@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   buf.assign(total, 0);
   shadow.assign(total, 0);
   Reassembler r;
-  r.Init(buf.data(), total);
+  r.Init(buf.data(), total, (data[0] & 0x80) != 0);  // high bit: a periodic signal
   bool shadow_valid = false;  // shadow holds the accepted prefix of value shadow_seq
   uint32_t shadow_seq = 0, shadow_next = 0;
 
@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         continue;
       }
       // Accepted: it must extend the shadow's prefix in order (or start a value at 0).
-      if (e.offset == 0 && (!shadow_valid || e.seq != shadow_seq || shadow_next == 0)) {
+      if (e.offset == 0) {  // only a value's start is accepted at offset 0
         shadow_valid = true;
         shadow_seq = e.seq;
         shadow_next = 0;

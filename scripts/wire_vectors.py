@@ -226,7 +226,7 @@ def vectors():
     ]
 
 
-def fragment_stream(count, values, part=1408, edit=None):
+def fragment_stream(count, values, part=1408, edit=None, periodic=False):
     """fuzz_reassembly input: uint32[count], each value (seq, fill) split as ccommd does."""
     frames = []
     for seq, fill in values:
@@ -236,7 +236,7 @@ def fragment_stream(count, values, part=1408, edit=None):
                                 entries=[Fragment(5, "uint32", [fill] * n, count, off, seq=seq, time_ns=seq)]).data())
     if edit:
         frames = edit(frames)
-    out = bytes([TYPES["uint32"][0] - 1]) + struct.pack(">H", count - 2)
+    out = bytes([TYPES["uint32"][0] - 1 + (0x80 if periodic else 0)]) + struct.pack(">H", count - 2)
     return out + b"".join(struct.pack(">H", len(f)) + f for f in frames)
 
 
@@ -248,6 +248,8 @@ def write_reassembly_corpus(d):
         "duplicate": fragment_stream(400, [(1, 7), (2, 8)], edit=lambda f: f[:1] + f[:1] + f[1:]),
         "gap": fragment_stream(1000, [(1, 7), (2, 8)], edit=lambda f: f[:1] + f[2:]),
         "reordered": fragment_stream(1000, [(1, 7), (2, 8)], edit=lambda f: [f[1], f[0]] + f[2:]),
+        "periodic-resend": fragment_stream(1000, [(1, 7), (1, 7), (2, 8)], periodic=True,
+                                           edit=lambda f: f[:1] + f[2:]),
     }
     for name, data in seeds.items():
         with open(os.path.join(d, name + ".bin"), "wb") as f:

@@ -35,6 +35,9 @@ constexpr uint32_t kMaxNameLength = 63;
 /// Largest value (count * element size) one signal may carry (64 KiB). Values that do not
 /// fit one frame travel in fragments (docs/protocol.md, "Large values").
 constexpr uint32_t kMaxValueBytes = 65536;
+/// Largest event queue of one signal (queue_depth x value bytes): 64 MiB, what 65536
+/// values of 1 KiB took before values could be larger; a segment is built in memory.
+constexpr uint64_t kMaxQueueBytes = uint64_t{64} << 20;
 
 struct RealtimeConfig {
   bool mlockall = true;

@@ -42,6 +42,7 @@ void CheckAccepted(const SystemConfig& c) {
     }
     Check(!s.has_safe_value || s.safe_value.size() == s.value_bytes());
     Check(s.queue_depth >= 2 && (s.queue_depth & (s.queue_depth - 1)) == 0);
+    Check(uint64_t{s.queue_depth} * s.value_bytes() <= kMaxQueueBytes);
   }
 }
 

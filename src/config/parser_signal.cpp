@@ -130,6 +130,11 @@ void Parser::SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs) {
         Err(line, "queue_depth " + std::to_string(depth) + " is not a power of two");
       else if (is_state)
         Err(line, "queue_depth applies only to event signals (a state holds one value)");
+      else if (uint64_t{depth} * sig->value_bytes() > kMaxQueueBytes)
+        Err(line, "queue_depth " + std::to_string(depth) + " x " + std::to_string(sig->value_bytes()) +
+                      "-byte values is more than " + std::to_string(kMaxQueueBytes >> 20) +
+                      " MiB of queue: at most " + std::to_string(kMaxQueueBytes / sig->value_bytes()) +
+                      " values of this size");
       else
         sig->queue_depth = depth;
     }

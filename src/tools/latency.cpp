@@ -99,7 +99,10 @@ struct Shared {
   bool any = false;
 };
 
+// One clock reading per cycle, as a control loop takes it (ccomm_set_time): every value
+// of the cycle is stamped with the cycle's start, so its latency includes the writes.
 void WriteAll(Shared* s, double k) {
+  ccomm_set_time(s->tx_client, static_cast<int64_t>(Now()));
   for (ccomm_signal id : s->send) ccomm_write_double(s->tx_client, id, k);
   ccomm_flush(s->tx_client);
 }
@@ -140,13 +143,14 @@ void* Receiver(void* arg) {
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
+    // One clock reading per cycle (ccomm_set_time), as the docs advise control loops:
+    // ages are measured from it, so the store time (t_read - age) is exact for values
+    // stored before it and reads as t_read for one stored during the reads (age 0).
+    const uint64_t t_read = Now();
+    ccomm_set_time(s->rx_client, static_cast<int64_t>(t_read));
     for (size_t i = 0; i < n; ++i) {
       double v;
       ccomm_info info;
-      // ccomm_read takes its clock reading for age_ns on entry: age measured from
-      // just before the call gives the store time even if the call was preempted by
-      // the very ccommd thread that stored the value.
-      const uint64_t t_read = s->stages ? Now() : 0;
       int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
       // Events queue: take every one waiting, keep the newest (one wake-up may find
       // several, and leaving them queued would delay every later sample).

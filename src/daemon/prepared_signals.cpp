@@ -39,15 +39,21 @@ void Daemon::PrepareRxTx() {
   }
 }
 
-// An entry that is not one this node takes from this sender: says why, in the counters.
-void Daemon::CountBadEntry(uint16_t signal, uint16_t sender) {
+// An entry that is not one this node takes from this sender: says why, in the counters
+// (the checks and their order as before the fast path; a group frame carries every
+// consumer's entries, so skipping those of signals not consumed here is normal).
+void Daemon::CountBadEntry(uint16_t signal, const wire::FrameHeader& h) {
   if (signal >= segment_.signal_count()) {
     Count(store::kEntriesUnknownSignal);
     return;
   }
   const store::SignalDirectoryEntry& d = segment_.dir(signal);
-  if (!(d.flags & store::kSigConsumedHere) || cfg_->signals[signal].producer != sender) {
-    Count(store::kFramesNotForUs);
+  if (cfg_->signals[signal].producer != h.sender) {
+    Count(store::kFramesNotForUs);  // the sender does not produce it: not a valid entry
+    return;
+  }
+  if (!(d.flags & store::kSigConsumedHere)) {
+    if (h.dest != wire::kDestAll || !fanout_multicast_) Count(store::kFramesNotForUs);
     return;
   }
   Count(store::kEntriesWrongType);  // consumed here from this sender: type, count or kind differ

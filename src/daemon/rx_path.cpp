@@ -149,7 +149,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     const uint16_t id = e.signal();
     const RxSignal* rs = id < rx_signals_.size() ? &rx_signals_[id] : nullptr;
     if (!rs || rs->prefix != e.prefix() || rs->producer != h.sender) {
-      CountBadEntry(id, h.sender);
+      CountBadEntry(id, h);
       continue;
     }
     // Rule 6; the next value in order (the common case) inline, the rest in AcceptValue.

@@ -38,27 +38,25 @@ def callgrind_numbers(cost):
     out = {}
     setup = ((cost or {}).get("callgrind") or {}).get("setup")
     if setup:
-        rx_ir = rx_n = tx_ir = tx_n = fl_ir = 0.0
-        frames = 0
+        # Receive: the daemon that gets the 36-entry frames (control -> planner); send:
+        # the one that sends them. Per-frame costs are spread over the frame's entries.
+        best = None
         for v in setup["nodes"].values():
             calls, ir = _per_call(v.get("per_call"), "receive: validate")
             if calls and ir is not None and v.get("rx"):
-                rx_ir += calls * ir
-                rx_n += v["rx"]
-                frames += calls
+                per_frame = v["rx"] / float(calls)
+                if best is None or per_frame > best[0]:
+                    best = (per_frame, calls * ir / v["rx"])
+        if best:
+            out["entries_per_frame"], out["rx_per_entry"] = best
+        best = None
+        for v in setup["nodes"].values():
             calls, ir = _per_call(v.get("per_call"), "send: collect")
-            if calls and ir is not None:
-                tx_ir += calls * ir
-                tx_n += calls
-            calls, ir = _per_call(v.get("per_call"), "send: finish")
-            if calls and ir is not None:
-                fl_ir += calls * ir
-        if rx_n:
-            out["rx_per_entry"] = rx_ir / rx_n
-            out["entries_per_frame"] = rx_n / frames if frames else None
-        if tx_n:
-            out["tx_per_signal"] = tx_ir / tx_n
-            out["tx_frame_share"] = fl_ir / tx_n
+            fcalls, fir = _per_call(v.get("per_call"), "send: finish")
+            if calls and ir is not None and (best is None or calls > best[0]):
+                best = (calls, ir, (fcalls * fir / calls) if fcalls and fir is not None else None)
+        if best:
+            out["tx_per_signal"], out["tx_frame_share"] = best[1], best[2]
     client = (cost or {}).get("callgrind_client")
     if client:
         for key, prefix in (("read", "ccomm_read_double"), ("write", "ccomm_write_double")):

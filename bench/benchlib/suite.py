@@ -172,6 +172,7 @@ SMOKE_CASES = {
     "ccomm_shm_state_spin_1khz_p8", "ccomm_shm_state_block_1khz_p8", "ccomm_shm_event_block_1khz_p8",
     "net_raw_oneway_1khz_p8", "net_udp_oneway_1khz_p8", "net_raw_rtt_half_1khz_p8", "lcm_netns_rtt_half_1khz_p8",
     "ccomm_raw_oneway_block_1khz_p8", "ccomm_udp_oneway_block_1khz_p8", "ccomm_raw_oneway_spin_1khz_p8",
+    "ccomm_raw_oneway_block_1khz_p288arr",
     "ccomm_raw_rtt_half_block_1khz_p8",
     "thesis_single_event_1khz", "thesis_setup_event_1khz", "thesis_setup_periodic_1khz",
     "thesis_setup_event_spin_10khz",

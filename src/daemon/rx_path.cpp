@@ -147,7 +147,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   bool stored = false;
   for (uint16_t i = 0; i < h.entry_count; ++i, e = e.next()) {
     const uint16_t id = e.signal();
-    const RxSignal* rs = id < rx_signals_.size() ? &rx_signals_[id] : nullptr;
+    const RxSignal* rs = id < segment_.signal_count() ? &rx_signals_[id] : nullptr;  // sized so (PrepareRxTx)
     if (!rs || rs->prefix != e.prefix() || rs->producer != h.sender) {
       CountBadEntry(id, h);
       continue;

@@ -155,10 +155,15 @@ int main(int argc, char** argv) {
   const int64_t start = start_at > 0 ? start_at : ccomm_now() + 100000000;
   const uint64_t cycles = (uint64_t)(seconds * rate + 0.5);
   uint64_t write_errors = 0, late = 0;
+  static int64_t late_at[kMaxEvents], late_by[kMaxEvents];  // cycle, ns: the first late cycles
   for (uint64_t k = 0; k < cycles + (uint64_t)drain_ms * 1000000 / (uint64_t)period; k++) {
     int64_t t = start + (int64_t)k * period;
     sleep_until(t);
-    if (ccomm_now() - t > period) late++;
+    int64_t lateness = ccomm_now() - t;
+    if (lateness > period) {
+      if (late < kMaxEvents) late_at[late] = (int64_t)k, late_by[late] = lateness;
+      late++;
+    }
     if (k < cycles) {
       for (int i = 0; i < g_nproduced; i++)
         if (ccomm_write_double(c, g_produced[i], (double)(k + 1)) != 0) write_errors++;
@@ -214,7 +219,9 @@ int main(int argc, char** argv) {
            (unsigned long long)st.writes, (unsigned long long)st.tx, (unsigned long long)st.coalesced,
            (unsigned long long)st.write_errors);
   }
-  printf("},\"consumed\":{");
+  printf("},\"late\":[");
+  for (uint64_t e = 0; e < late && e < kMaxEvents; e++) printf("%s[%lld,%lld]", e ? "," : "", (long long)late_at[e], (long long)late_by[e]);
+  printf("],\"consumed\":{");
   for (int i = 0; i < g_nconsumed; i++) {
     Consumed* s = &g_consumed[i];
     ccomm_signal_stats st;

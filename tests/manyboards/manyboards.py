@@ -186,7 +186,7 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
     Exact means: every value a producer's ccommd sent reached every consumer (rx == tx,
     every sequence gap is a value the producer coalesced), and values are coalesced
     (replaced by the next cycle's before ccommd sent them) only after a cycle in which the
-    application itself woke more than a period late and so flushed twice in a row: that is
+    application itself woke more than half a period late and so flushed twice in quick succession: that is
     the host descheduling a SCHED_FIFO thread, reported, not a loss of the system."""
     a = r.args
     r.check(all(res.values()), "every board's application ran and reported")
@@ -208,7 +208,7 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
     r.check(len(prod) == n * a.signals and all(v["writes"] == cycles and not v["write_errors"] for v in prod.values()),
             "%d signals written %d times each (%d boards x %d), none refused" % (len(prod), cycles, n, a.signals))
     r.check(not unexplained, "every write sent (tx + coalesced == writes); %d values coalesced, each after an "
-            "application cycle that woke more than a period late (%d such cycles: host scheduling)%s"
+            "application cycle that woke more than half a period late (%d such cycles: host scheduling)%s"
             % (coalesced_total, late_total, "" if not unexplained else ": " + "; ".join(unexplained[:4])))
     wrong = []
     for j, name in enumerate(nodes):

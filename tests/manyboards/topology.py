@@ -65,7 +65,7 @@ class Topology:
     def create(self):
         self._ns_new(self.sw)
         sh("ip", "-n", self.sw, "link", "add", "br0", "type", "bridge", "mcast_snooping", "1",
-           "mcast_querier", "1", "stp_state", "0", "forward_delay", "0")
+           "mcast_querier", "1", "mcast_igmp_version", "3", "stp_state", "0", "forward_delay", "0")
         sh("ip", "-n", self.sw, "link", "set", "br0", "up")
         for i in range(self.n):
             ns = self.ns(i)
@@ -75,8 +75,6 @@ class Topology:
             sh("ip", "-n", self.sw, "link", "set", "p%d" % i, "master", "br0", "up")
             sh("ip", "-n", ns, "addr", "add", ip_of(i) + "/24", "dev", "eth0")
             sh("ip", "-n", ns, "link", "set", "eth0", "up")
-            # IGMPv2 reports (v3 would also work; v2 keeps the snooping table simple)
-            sh("ip", "netns", "exec", ns, "sysctl", "-qw", "net.ipv4.conf.eth0.force_igmp_version=2")
             batch = "".join("neigh replace %s lladdr %s dev eth0 nud permanent\n" % (ip_of(j), mac_of(j))
                             for j in range(self.n) if j != i)
             subprocess.run(["ip", "-n", ns, "-batch", "-"], input=batch, text=True, check=True)

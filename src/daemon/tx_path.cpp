@@ -119,6 +119,10 @@ void Daemon::SettleSteps(uint32_t steps_before) {
         if (p.open)
           p.writer.Rewrite(static_cast<uint16_t>(id), static_cast<uint32_t>(m.value_seq), m.source_time_ns, tx_value_);
       }
+      // The value taken first (counted in tx) is replaced in the frame: it and any written
+      // between never leave, so they count as coalesced, as in CollectSignal.
+      if (m.value_seq > last_tx_seq_[id])
+        segment_.stats(id).coalesced.fetch_add(m.value_seq - last_tx_seq_[id], std::memory_order_relaxed);
       last_tx_seq_[id] = m.value_seq;
     }
   }

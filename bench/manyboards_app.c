@@ -4,6 +4,7 @@
 //
 //   manyboards_app --node NAME --rate HZ --seconds S [--drain-ms 500] [--prio P]
 //                  [--start-at T]   (CLOCK_MONOTONIC ns of cycle 0: every board the same)
+//                  [--latency 0]    (no receiver thread: no latency samples, less load)
 //
 // Control thread (SCHED_FIFO P if given), every cycle: writes each signal produced on
 // this node (value = cycle number, 1, 2, ...), ccomm_flush() (one frame per destination
@@ -93,7 +94,7 @@ static void* reader_main(void* arg) {
 
 static void usage(void) {
   fputs("usage: manyboards_app --node NAME --rate HZ --seconds S [--drain-ms MS] [--prio P]\n"
-        "                      [--start-at CLOCK_MONOTONIC_NS]\n"
+        "                      [--start-at CLOCK_MONOTONIC_NS] [--latency 0|1]\n"
         "One board's application in the many-board test: writes the node's produced signals\n"
         "every cycle (value = cycle number), follows the freshness of the consumed ones and\n"
         "their one-way latency, then prints one JSON line of counters.\n", stderr);
@@ -111,6 +112,7 @@ int main(int argc, char** argv) {
   double rate = 1000, seconds = 10;
   int drain_ms = 500, prio = 0;
   int64_t start_at = 0;
+  int latency = 1;
   for (int i = 1; i + 1 < argc + 1; i += 2) {
     if (i + 1 >= argc) usage();
     const char *a = argv[i], *v = argv[i + 1];
@@ -120,6 +122,7 @@ int main(int argc, char** argv) {
     else if (!strcmp(a, "--drain-ms")) drain_ms = atoi(v);
     else if (!strcmp(a, "--prio")) prio = atoi(v);
     else if (!strcmp(a, "--start-at")) start_at = atoll(v);
+    else if (!strcmp(a, "--latency")) latency = atoi(v);
     else usage();
   }
   if (!node || rate <= 0 || seconds <= 0) usage();
@@ -147,7 +150,7 @@ int main(int argc, char** argv) {
   set_fifo(prio);
   ReaderArgs ra = {node, prio};
   pthread_t reader;
-  if (pthread_create(&reader, NULL, reader_main, &ra) != 0) {
+  if (latency && pthread_create(&reader, NULL, reader_main, &ra) != 0) {
     fputs("manyboards_app: cannot start the receiver thread\n", stderr);
     return 1;
   }
@@ -199,7 +202,7 @@ int main(int argc, char** argv) {
     }
   }
   atomic_store(&g_stop, 1);
-  pthread_join(reader, NULL);
+  if (latency) pthread_join(reader, NULL);
 
   qsort(g_samples, g_nsamples, sizeof g_samples[0], cmp_i64);
   struct rusage ru;

@@ -27,7 +27,7 @@ import topology  # noqa: E402
 def run_one(args, mode, n, transport, rate):
     a = argparse.Namespace(build=args.build, boards=n, rate=rate, seconds=args.seconds, transport=transport,
                            fanout=args.fanout, monitor="none", consumers=1, signals=4, stale_after_ms=50,
-                           stale_tolerance_ms=10, kill=False, prio=70, daemon_prio=80, work=None)
+                           stale_tolerance_ms=10, kill=False, prio=70, daemon_prio=80, work=None, latency=True)
     r, summary = manyboards.floor(a) if mode == "floor" else manyboards.system(a)
     summary["ok"] = bool(r.checks) and all(ok for ok, _ in r.checks)
     summary["failed"] = [t for ok, t in r.checks if not ok]

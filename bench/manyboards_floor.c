@@ -13,6 +13,7 @@
 // "p99_ns":..,"cpu_s":..,"late_cycles":..}. Exit 0, or 1 on a setup error.
 #include <arpa/inet.h>
 #include <errno.h>
+#include <linux/filter.h>
 #include <linux/if_packet.h>
 #include <net/ethernet.h>
 #include <net/if.h>
@@ -112,6 +113,19 @@ int main(int argc, char** argv) {
                                .mr_address = {0x03, 0x63, 0x63, 0x6d, 0x00, (unsigned char)from[k]}};
       if (setsockopt(fd, SOL_PACKET, PACKET_ADD_MEMBERSHIP, &mr, sizeof mr) < 0) die("PACKET_ADD_MEMBERSHIP");
     }
+    // Like ccommd: a kernel socket filter passes only the groups wanted (the bridge floods
+    // raw multicast to every port), so other boards' frames never wake this process.
+    // Classic BPF on the frame's sender byte (offset 4, little-endian low byte).
+    struct sock_filter code[kMaxBoards + 3];
+    int nc = 0;
+    code[nc++] = (struct sock_filter)BPF_STMT(BPF_LD | BPF_B | BPF_ABS, 4);
+    for (int k = 0; k < nfrom; k++)  // jump to "accept" (the last instruction) on a match
+      code[nc++] = (struct sock_filter)BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, (uint32_t)from[k],
+                                                (uint8_t)(nfrom - k), 0);
+    code[nc++] = (struct sock_filter)BPF_STMT(BPF_RET | BPF_K, 0);
+    code[nc++] = (struct sock_filter)BPF_STMT(BPF_RET | BPF_K, 0xFFFF);
+    struct sock_fprog prog = {.len = (unsigned short)nc, .filter = code};
+    if (setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &prog, sizeof prog) < 0) die("SO_ATTACH_FILTER");
     memset(&to_ll, 0, sizeof to_ll);
     to_ll.sll_family = AF_PACKET;
     to_ll.sll_protocol = htons(kEtherType);

@@ -75,7 +75,8 @@ def render(rows, args, meta):
          "the consumer application's read, one CLOCK_MONOTONIC for all namespaces); CPU is ccommd's "
          "utime+stime over the run (from `/proc/PID/stat`) as %% of one core, the median over boards. "
          "The floor is `bench/manyboards_floor.c` in the same topology: one bare socket per board "
-         "sending one frame per cycle to its own multicast group and receiving the groups it wants."
+         "sending one frame per cycle to its own multicast group and receiving the groups it wants (raw: "
+         "through a kernel socket filter, as ccommd)."
          % (meta["date"], meta["commit"], meta["machine"], " and ".join("%g" % x for x in args.rates), args.fanout),
          ""]
     for tr, rate in [(t, x) for x in args.rates for t in args.transports]:
@@ -116,9 +117,8 @@ def render(rows, args, meta):
           "With UDP the bridge's IGMP snooping delivers it only those streams, so its receive cost follows what "
           "it consumes, not the size of the system. Raw Ethernet multicast is flooded by a plain bridge or "
           "unmanaged switch to every port; ccommd's packet socket carries a kernel socket filter for the "
-          "joined groups, so the frames of other groups are dropped in the kernel without waking ccommd: the "
-          "ccommd column stays flat while the raw floor, which filters in user space, gets slower at 16 "
-          "boards. What does grow with N is the host: all boards share these 2 CPUs, so at 1 kHz x 16 boards "
+          "joined groups, so the frames of other groups are dropped in the kernel without waking ccommd (the "
+          "floor does the same). What does grow with N is the host: all boards share these 2 CPUs, so at 1 kHz x 16 boards "
           "(ccommd + application about 9 % of a core per board, 16 x 1000 cycles/s with ~8 thread wake-ups "
           "each) the machine is close to saturation and the applications' SCHED_FIFO threads start waking "
           "late; on real boards each has its own CPU.", ""]

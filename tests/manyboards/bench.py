@@ -76,22 +76,26 @@ def render(rows, args, meta):
          "utime+stime over the run (from `/proc/PID/stat`) as %% of one core, the median over boards. "
          "The floor is `bench/manyboards_floor.c` in the same topology: one bare socket per board "
          "sending one frame per cycle to its own multicast group and receiving the groups it wants (raw: "
-         "through a kernel socket filter, as ccommd)."
+         "through a kernel socket filter, as ccommd). CPU pressure is the share of the ccomm run during which "
+         "some task on the host waited for a CPU (`/proc/pressure/cpu`): the VM is shared with other builds, "
+         "so single 5 s runs vary (two runs on 2026-11-25 differed by up to about 20 %% per ccomm cell, the floor's "
+         "small CPU figures by more)."
          % (meta["date"], meta["commit"], meta["machine"], " and ".join("%g" % x for x in args.rates), args.fanout),
          ""]
     for tr, rate in [(t, x) for x in args.rates for t in args.transports]:
         R = [r for r in rows if r["transport"] == tr and r["rate"] == rate]
         base = next((r for r in R if r["boards"] == min(args.boards)), None)
         L += ["| %s %g Hz, boards | ccomm p50 us | vs %d boards | ccommd CPU %% | vs %d boards | app CPU %% | "
-              "floor p50 us | floor CPU %% | all values exact |" % (tr, rate, min(args.boards), min(args.boards)),
-              "|---:|---:|---:|---:|---:|---:|---:|---:|:---|"]
+              "floor p50 us | floor CPU %% | CPU pressure %% | all values exact |" % (tr, rate, min(args.boards), min(args.boards)),
+              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---|"]
         for r in R:
             c, f = r["ccomm"], r["floor"]
-            L.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            L.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 r["boards"], us(c.get("p50_ns")), ratio(c.get("p50_ns"), base["ccomm"].get("p50_ns")),
                 pct(c.get("cpu_pct_per_board")),
                 ratio(c.get("cpu_pct_per_board"), base["ccomm"].get("cpu_pct_per_board")),
                 pct(c.get("app_cpu_pct_per_board")), us(f.get("p50_ns")), pct(f.get("cpu_pct_per_board")),
+                "%.0f" % (100 * c["cpu_pressure"]) if c.get("cpu_pressure") is not None else "-",
                 "yes" if c.get("ok") else "**no**: " + "; ".join(c.get("failed", []))[:200]))
         L.append("")
     checks = []

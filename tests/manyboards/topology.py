@@ -35,7 +35,7 @@ def ip_of(i):
 
 
 def sweep_stale(prefix_re=r"^mb([0-9]+)-"):
-    """Namespaces of an earlier run that was killed outright (its pid is gone)."""
+    """Namespaces and segments of an earlier run that was killed outright (pid gone)."""
     for line in sh("ip", "netns", "list", check=False).splitlines():
         name = line.split()[0] if line.split() else ""
         m = re.match(prefix_re, name)
@@ -43,6 +43,10 @@ def sweep_stale(prefix_re=r"^mb([0-9]+)-"):
             for pid in sh("ip", "netns", "pids", name, check=False).split():
                 sh("kill", "-9", pid, check=False)
             sh("ip", "netns", "del", name, check=False)
+    for f in os.listdir("/dev/shm"):  # segments of such a run (CCOMM_SHM_PREFIX=/mbPID.)
+        m = re.match(r"^mb([0-9]+)\.", f)
+        if m and not os.path.isdir("/proc/%s" % m.group(1)):
+            os.unlink(os.path.join("/dev/shm", f))
 
 
 class Topology:

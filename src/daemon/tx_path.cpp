@@ -87,7 +87,9 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   store::MarkStateForwarded(sv, version);
   if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
   uint64_t& last = last_tx_seq_[id];
-  if (!periodic && last && m.value_seq > last + 1)
+  // Values are numbered from 1 in a segment this ccommd created, so values replaced before
+  // the first one sent count too; after re-adoption the predecessor is unknown.
+  if (!periodic && (last || !adopted_) && m.value_seq > last + 1)
     segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
   last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);

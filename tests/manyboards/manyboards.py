@@ -200,7 +200,7 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
     """Phase 1: exact per-signal counters everywhere, frames per cycle on the bridge.
 
     Exact means: every value a producer's ccommd sent reached every consumer (rx == tx,
-    every sequence gap is a value the producer coalesced), and values are coalesced
+    every sequence gap a value the producer coalesced), and values are coalesced
     (replaced by the next cycle's before ccommd sent them) only after a cycle in which the
     application itself woke more than half a period late and so flushed twice in quick succession: that is
     the host descheduling a SCHED_FIFO thread, reported, not a loss of the system."""
@@ -246,7 +246,9 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
             wrong.append("%s consumes %d signals, expected %d" % (name, len(got), len(want)))
         for sig, v in got.items():
             p = prod.get(sig, {"tx": -1, "coalesced": -1})
-            if v["rx"] != p["tx"] or v["lost"] != p["coalesced"] or v["last_value"] != cycles:
+            # lost <= coalesced: a receiver counts gaps from the first value it got, so a
+            # value replaced before the first send is the producer's to count only.
+            if v["rx"] != p["tx"] or v["lost"] > p["coalesced"] or v["last_value"] != cycles:
                 wrong.append("%s %s rx %d lost %d last %s (sent %d, coalesced %d)" % (
                     name, sig, v["rx"], v["lost"], v["last_value"], p["tx"], p["coalesced"]))
     r.check(not wrong, "per-signal counters exact on every consumer: rx == values sent, no value lost in "

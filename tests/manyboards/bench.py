@@ -78,7 +78,7 @@ def render(rows, args, meta):
          "sending one frame per cycle to its own multicast group and receiving the groups it wants (raw: "
          "through a kernel socket filter, as ccommd). CPU pressure is the share of the ccomm run during which "
          "some task on the host waited for a CPU (`/proc/pressure/cpu`): the VM is shared with other builds, "
-         "so single 5 s runs vary (two runs on 2026-11-25 differed by up to about 20 %% per ccomm cell, the floor's "
+         "so single 5 s runs vary (three runs on 2026-11-25 differed by up to about 30 %% per ccomm cell, the floor's "
          "small CPU figures by more)."
          % (meta["date"], meta["commit"], meta["machine"], " and ".join("%g" % x for x in args.rates), args.fanout),
          ""]

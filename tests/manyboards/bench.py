@@ -64,7 +64,7 @@ def render(rows, args, meta):
     L = ["<!-- SPDX-License-Identifier: Apache-2.0 -->",
          "<!-- Written by tests/manyboards/bench.py (scripts/bench runs it); scripts/bench copies this file "
          "into docs/performance.md. -->",
-         "## 8. Many boards on one segment", "",
+         "## 9. Many boards on one segment", "",
          "Measured by `tests/manyboards/bench.py` (run by `scripts/bench`) on %s at commit %s. Machine: %s. "
          "N network namespaces, one per board, each joined by a veth pair to one Linux bridge (IGMP snooping "
          "on, the bridge its own querier); in each, one ccommd (SCHED_FIFO 80) and one application "

@@ -2,7 +2,7 @@
 """Large values (docs/protocol.md "Large values"): one double array of 1 KiB (one frame)
 and one of 64 KiB (47 fragments) sent board -> board at 100 Hz, one-way latency from the
 producer's write to the reader, and the CPU time both ccommd spent per value. The rows go
-to results.json (section "large"); docs/perf/sections/8-large-values.md reports them."""
+to results.json (section "large"); docs/perf/sections/10-large-values.md reports them."""
 
 import os
 
@@ -14,9 +14,7 @@ SIGNAL = "big"
 
 def pair_config(names, count, transport, ns_pair, prio, cpus):
     """The bench's two boards with one double[count] signal names[0] -> names[1]."""
-    text = ccomm.pair_config(names, [SIGNAL], [], transport, ns_pair, 0, prio, cpus)
-    old = '<signal name="%s" type="double"' % SIGNAL
-    return text.replace(old, old + ' count="%d"' % count, 1)
+    return ccomm.pair_config(names, ["%s:%d" % (SIGNAL, count)], [], transport, ns_pair, 0, prio, cpus)
 
 
 def run_large(ctx, case):

@@ -56,7 +56,15 @@ void Daemon::SendFragments(uint32_t id, const store::SignalDirectoryEntry& d, ui
   }
 }
 
-bool Daemon::HandleFragment(const wire::FrameHeader& h, const wire::EntryView& e, uint64_t now) {
+bool Daemon::HandleFragment(const wire::FrameHeader& h, const wire::EntryRef& ref, uint64_t now) {
+  wire::EntryView e;
+  ref.Read(&e);
+  // Not a signal this node takes from this sender: counted as any such entry.
+  if (e.signal >= segment_.signal_count() || cfg_->signals[e.signal].producer != h.sender ||
+      !(segment_.dir(e.signal).flags & store::kSigConsumedHere)) {
+    CountBadEntry(e.signal, h);
+    return false;
+  }
   const store::SignalDirectoryEntry& d = segment_.dir(e.signal);
   const SignalConfig& sc = cfg_->signals[e.signal];
   store::SignalStats& ss = segment_.stats(e.signal);
@@ -87,12 +95,15 @@ bool Daemon::HandleFragment(const wire::FrameHeader& h, const wire::EntryView& e
   // the sequence and counted as lost here, once each.
   const uint64_t value_seq = AcceptValue(e.signal, l.reasm.seq(), is_event || sc.period_us == 0);
   if (value_seq == 0) return false;
-  const store::StoreResult w =
-      is_event ? store::RingWrite(segment_.ring(e.signal), l.reasm.value(), value_seq, l.reasm.source_time_ns(), now)
-               : store::StateWrite(segment_.state(e.signal), l.reasm.value(), value_seq, l.reasm.source_time_ns(), now);
-  if (w != store::StoreResult::kOk) {
-    ss.write_errors.fetch_add(1, std::memory_order_relaxed);
-    return false;
+  if (is_event) {
+    if (store::RingWrite(segment_.ring(e.signal), l.reasm.value(), value_seq, l.reasm.source_time_ns(), now) !=
+        store::StoreResult::kOk) {
+      ss.write_errors.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+  } else {  // ccommd is the only writer of a received state (HandleFrame fences after the frame)
+    store::StateWriteSingle(segment_.state(e.signal), l.reasm.value(),
+                            store::SlotMeta{value_seq, l.reasm.source_time_ns(), now});
   }
   ss.rx.fetch_add(1, std::memory_order_relaxed);
   ss.last_rx_ns.store(now, std::memory_order_relaxed);

@@ -59,16 +59,36 @@ inline size_t DeclaredLength(const uint8_t* buf) {
   return total;
 }
 
-// Bytes before the value (or part) of the entry at `p`: 24, or 32 for a fragment.
-inline size_t ValueOffset(const uint8_t* p) {
-  return kEntryHeaderSize + ((p[kEOffFlags] & kEntryFragment) ? kFragmentHeaderSize : 0);
-}
-
 // The fragment rules of docs/protocol.md: a non-empty, element-aligned, strict part of a
 // value of count x esize <= kMaxFragmentedValue bytes.
 bool FragmentValid(size_t esize, size_t count, size_t part_len, size_t total, size_t offset) {
-  return total == count * esize && total <= kMaxFragmentedValue && part_len > 0 && part_len < total &&
-         part_len % esize == 0 && offset % esize == 0 && offset < total && part_len <= total - offset;
+  return esize != 0 && total == count * esize && total <= kMaxFragmentedValue && part_len > 0 &&
+         part_len < total && part_len % esize == 0 && offset % esize == 0 && offset < total &&
+         part_len <= total - offset;
+}
+
+// A fragment entry (flags bit 1), out of the common path: the rules of CheckEntry with
+// the sub-header's instead of value_len == count x size.
+DecodeError CheckFragmentEntry(const uint8_t* p, size_t left, size_t esize, size_t count, size_t value_len,
+                               size_t* size) {
+  if ((esize == 0) | ((p[kEOffFlags] & ~kKnownEntryFlags) != 0) | (count == 0) |
+      (Load<uint32_t>(p + kEOffReserved) != 0) | (left < kEntryHeaderSize + kFragmentHeaderSize))
+    return DecodeError::kBadEntry;
+  if (!FragmentValid(esize, count, value_len, Load<uint32_t>(p + kFOffTotal), Load<uint32_t>(p + kFOffOffset)))
+    return DecodeError::kBadEntry;
+  const size_t total = kEntryHeaderSize + kFragmentHeaderSize + Padded(value_len);
+  if (total > left) return DecodeError::kBadEntry;
+  const uint8_t* v = p + kEntryHeaderSize + kFragmentHeaderSize;
+  if (esize == 1) {  // bool
+    for (size_t i = 0; i < value_len; ++i) {
+      if (v[i] > 1) return DecodeError::kBadEntry;
+    }
+  }
+  for (size_t i = value_len; i < Padded(value_len); ++i) {
+    if (v[i] != 0) return DecodeError::kBadEntry;
+  }
+  *size = total;
+  return DecodeError::kOk;
 }
 
 // Checks one entry at `p` with `left` payload bytes remaining; on success stores its wire
@@ -76,31 +96,32 @@ bool FragmentValid(size_t esize, size_t count, size_t part_len, size_t total, si
 DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
   if (left < kEntryHeaderSize) return DecodeError::kBadEntry;
   const uint8_t type = p[kEOffType];
-  const size_t esize = ValueTypeSize(type);
-  if (esize == 0) return DecodeError::kBadEntry;
-  if (p[kEOffFlags] & ~kKnownEntryFlags) return DecodeError::kBadEntry;
+  // Element sizes by type code (ValueTypeSize as a table: this runs once per entry).
+  static constexpr uint8_t kElemSize[8] = {0, 1, 4, 4, 8, 4, 8, 0};
+  static_assert(kElemSize[1] == ValueTypeSize(1) && kElemSize[2] == ValueTypeSize(2) &&
+                    kElemSize[3] == ValueTypeSize(3) && kElemSize[4] == ValueTypeSize(4) &&
+                    kElemSize[5] == ValueTypeSize(5) && kElemSize[6] == ValueTypeSize(6) &&
+                    ValueTypeSize(7) == 0 && ValueTypeSize(0) == 0,
+                "kElemSize is ValueTypeSize");
+  const size_t esize = type < 8 ? kElemSize[type] : 0;
   const size_t count = Load<uint16_t>(p + kEOffCount);
   const size_t value_len = Load<uint16_t>(p + kEOffLen);
-  if (count == 0) return DecodeError::kBadEntry;
-  if (Load<uint32_t>(p + kEOffReserved) != 0) return DecodeError::kBadEntry;
-  const size_t head = ValueOffset(p);
-  if (head > left) return DecodeError::kBadEntry;
-  if (p[kEOffFlags] & kEntryFragment) {
-    if (!FragmentValid(esize, count, value_len, Load<uint32_t>(p + kFOffTotal), Load<uint32_t>(p + kFOffOffset)))
-      return DecodeError::kBadEntry;
-  } else if (value_len != count * esize) {
+  if (p[kEOffFlags] & kEntryFragment) return CheckFragmentEntry(p, left, esize, count, value_len, size);
+  if ((esize == 0) | ((p[kEOffFlags] & ~kKnownEntryFlags) != 0) | (count == 0) | (value_len != count * esize) |
+      (Load<uint32_t>(p + kEOffReserved) != 0))
     return DecodeError::kBadEntry;
-  }
-  const size_t total = head + Padded(value_len);
+  const size_t total = kEntryHeaderSize + Padded(value_len);
   if (total > left) return DecodeError::kBadEntry;
-  const uint8_t* v = p + head;
-  if (type == kTypeBool) {
-    for (size_t i = 0; i < value_len; ++i) {
-      if (v[i] > 1) return DecodeError::kBadEntry;
+  if (type == kTypeBool || (value_len & 7)) {  // whole 8-byte words of a 4/8-byte type: nothing more to check
+    const uint8_t* v = p + kEntryHeaderSize;
+    if (type == kTypeBool) {
+      for (size_t i = 0; i < value_len; ++i) {
+        if (v[i] > 1) return DecodeError::kBadEntry;
+      }
     }
-  }
-  for (size_t i = value_len; i < Padded(value_len); ++i) {
-    if (v[i] != 0) return DecodeError::kBadEntry;
+    for (size_t i = value_len; i < Padded(value_len); ++i) {
+      if (v[i] != 0) return DecodeError::kBadEntry;
+    }
   }
   *size = total;
   return DecodeError::kOk;
@@ -152,6 +173,7 @@ void FrameWriter::Begin(const FrameHeader& h) {
   if (buf_ == nullptr || cap_ < kHeaderSize || (h.flags & ~kKnownFrameFlags) != 0) return;
   const size_t max = kMaxFrameSize - ((h.flags & kFlagAuth) ? kAuthTagSize : 0);
   limit_ = cap_ < max ? cap_ : max;
+  if (h.flags & kFlagHeartbeat) limit_ = kHeaderSize;  // heartbeats carry no entries: no room for one
   Store<uint32_t>(buf_ + kOffMagic, kMagic);
   buf_[kOffVersion] = kVersion;  // this codec writes v1 only, whatever h.version says
   buf_[kOffFlags] = h.flags;
@@ -173,7 +195,7 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   if (count_ == UINT16_MAX) return false;
   const size_t esize = ValueTypeSize(type);
   if (esize == 0 || count == 0 || value_len != size_t{count} * esize) return false;
-  if ((flags & ~kEntryEvent) != 0 || value == nullptr) return false;  // fragments: AddFragment
+  if ((flags & ~kEntryEvent) != 0 || value == nullptr) return false;
   // limit_ <= kMaxFrameSize, so value_len and the sizes below stay far from overflow
   // once this check passes.
   if (value_len > limit_ || EntrySize(value_len) > limit_ - len_) return false;
@@ -191,6 +213,47 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   uint8_t* v = p + kEntryHeaderSize;
   EncodeValue(v, value, esize, count);
   std::memset(v + value_len, 0, Padded(value_len) - value_len);
+  len_ += EntrySize(value_len);
+  ++count_;
+  return true;
+}
+
+uint64_t EntryPrefix(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, size_t value_len) {
+  const size_t esize = ValueTypeSize(type);
+  // Never a fragment's (those are written by AddFragment), nor a value no frame can hold.
+  if (esize == 0 || count == 0 || value_len != size_t{count} * esize || (flags & ~kEntryEvent) != 0 ||
+      !FrameWriter::FitsOneFrame(value_len, false))
+    return 0;
+  uint8_t b[8];
+  Store<uint16_t>(b + kEOffSignal, signal);
+  b[kEOffType] = type;
+  b[kEOffFlags] = flags;
+  Store<uint16_t>(b + kEOffCount, count);
+  Store<uint16_t>(b + kEOffLen, static_cast<uint16_t>(value_len));
+  uint64_t w;
+  std::memcpy(&w, b, 8);
+  return w;
+}
+
+bool FrameWriter::AddPreparedGeneric(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, const void* value,
+                                     size_t value_len) {
+  if (len_ < kHeaderSize || (buf_[kOffFlags] & kFlagHeartbeat) || prefix == 0 || value == nullptr) return false;
+  if (value_len > limit_ || EntrySize(value_len) > limit_ - len_) return false;
+  uint8_t* p = buf_ + len_;
+  std::memcpy(p, &prefix, 8);
+  Store<uint32_t>(p + kEOffSeq, seq);
+  Store<uint32_t>(p + kEOffReserved, 0);
+  Store<uint64_t>(p + kEOffTime, source_time_ns);
+  uint8_t* v = p + kEntryHeaderSize;
+  const size_t esize = ValueTypeSize(p[kEOffType]);
+  if (esize == 8 && value_len == 8) {  // the common case: one 8-byte value, no padding
+    uint64_t x;
+    std::memcpy(&x, value, 8);
+    Store<uint64_t>(v, x);
+  } else {
+    EncodeValue(v, value, esize, value_len / esize);
+    std::memset(v + value_len, 0, Padded(value_len) - value_len);
+  }
   len_ += EntrySize(value_len);
   ++count_;
   return true;
@@ -238,7 +301,7 @@ bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns
       EncodeValue(p + kEntryHeaderSize, value, ValueTypeSize(p[kEOffType]), Load<uint16_t>(p + kEOffCount));
       return true;
     }
-    off += ValueOffset(p) + Padded(value_len);
+    off += EntryValueOffset(p) + Padded(value_len);
   }
   return false;
 }
@@ -251,7 +314,9 @@ size_t FrameWriter::Finish() {
   return len_;
 }
 
-DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
+DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) { return DecodeFrame(buf, len, h, nullptr, 0); }
+
+DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const uint64_t* known, size_t known_count) {
   if (buf == nullptr || len < kHeaderSize) return DecodeError::kTooShort;
   if (Load<uint32_t>(buf + kOffMagic) != kMagic) return DecodeError::kBadMagic;
   if (buf[kOffVersion] != kVersion) return DecodeError::kBadVersion;
@@ -276,6 +341,21 @@ DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
   size_t left = payload_len;
   for (uint16_t i = 0; i < entry_count; ++i) {
     size_t size = 0;
+    if (left >= kEntryHeaderSize) {
+      // A known entry: its first 8 bytes are ones CheckEntry accepts (EntryPrefix) with
+      // whole-word values, so only the reserved word and the bounds are left to check.
+      const uint16_t signal = Load<uint16_t>(p + kEOffSignal);
+      uint64_t prefix;
+      std::memcpy(&prefix, p, 8);
+      if (signal < known_count && known[signal] == prefix && prefix != 0 && Load<uint32_t>(p + kEOffReserved) == 0) {
+        size = kEntryHeaderSize + Load<uint16_t>(p + kEOffLen);
+        if (size <= left) {
+          p += size;
+          left -= size;
+          continue;
+        }
+      }
+    }
     const DecodeError e = CheckEntry(p, left, &size);
     if (e != DecodeError::kOk) return e;
     p += size;
@@ -303,29 +383,6 @@ size_t TrimEthernetPadding(const uint8_t* buf, size_t len) {
     if (buf[i] != 0) return len;  // not padding: let DecodeHeader report trailing bytes
   }
   return total;
-}
-
-bool EntryIterator::Next(EntryView* e) {
-  if (left_ == 0) return false;
-  e->signal = Load<uint16_t>(p_ + kEOffSignal);
-  e->type = p_[kEOffType];
-  e->flags = p_[kEOffFlags];
-  e->count = Load<uint16_t>(p_ + kEOffCount);
-  e->value_len = Load<uint16_t>(p_ + kEOffLen);
-  e->seq = Load<uint32_t>(p_ + kEOffSeq);
-  e->source_time_ns = Load<uint64_t>(p_ + kEOffTime);
-  const size_t head = ValueOffset(p_);
-  if (e->flags & kEntryFragment) {
-    e->total_len = Load<uint32_t>(p_ + kFOffTotal);
-    e->offset = Load<uint32_t>(p_ + kFOffOffset);
-  } else {
-    e->total_len = e->value_len;
-    e->offset = 0;
-  }
-  e->value = p_ + head;
-  p_ += head + Padded(e->value_len);
-  --left_;
-  return true;
 }
 
 void ValueToHost(uint8_t type, const uint8_t* src, void* dst, size_t count) {

@@ -60,6 +60,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ++n;
     Check(ref.prefix() == e.prefix && ref.signal() == e.signal && ref.seq() == e.seq &&
           ref.value() == e.value && ref.value_len() == e.value_len && ref.source_time_ns() == e.source_time_ns);
+    EntryView rv;
+    ref.Read(&rv);
+    Check(rv.total_len == e.total_len && rv.offset == e.offset && rv.flags == e.flags && rv.count == e.count);
     ref = ref.next();
     Check(e.value >= data && e.value + e.value_len <= data + len);
     Check(e.value_len <= sizeof g_host);

@@ -90,8 +90,8 @@ class Daemon {
     uint64_t ext = 0;           // its 64-bit extension: the value_seq stored
   };
 
-  // What the receive path needs of a signal, resolved once in Start() (rx_path.cpp): an
-  // entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
+  // What the receive path needs of a signal, resolved once in Start() (prepared_signals.cpp):
+  // an entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
   // one this node consumes, of the right type, count and kind. prefix 0 = not consumed.
   struct RxSignal {
     uint64_t prefix = 0;

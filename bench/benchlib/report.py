@@ -983,7 +983,11 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
     # its own file, docs/perf/sections/*.md, and is copied here as it is.
     sections = os.path.join(doc_dir, "perf", "sections")
     _write_per_signal_section(R, meta, sections)
-    for name in sorted(os.listdir(sections)) if os.path.isdir(sections) else []:
+    def section_order(name):  # "10-x.md" after "9-y.md"
+        number = name.split("-", 1)[0]
+        return (int(number) if number.isdigit() else 1 << 30, name)
+
+    for name in sorted(os.listdir(sections), key=section_order) if os.path.isdir(sections) else []:
         if name.endswith(".md"):
             text = open(os.path.join(sections, name), encoding="utf-8").read()
             L.append("".join(l for l in text.splitlines(True) if not l.startswith("<!--")).rstrip() + "\n")

@@ -99,6 +99,10 @@ class Daemon {
   uint64_t AcceptValue(uint32_t id, uint32_t seq, bool count_gaps);
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
+  /// History tap (<node history="N">): appends a stored state value to its ring, if any.
+  void AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
+    if (history_[id].ring) store::RingWrite(history_[id], value, seq, source_ns, now);
+  }
   void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
     segment_.header()->daemon_counters[c].fetch_add(1, order);
   }
@@ -122,6 +126,7 @@ class Daemon {
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
   std::vector<SignalRx> rx_seq_;                  // signal -> last value received (rule 6)
+  std::vector<store::RingView> history_;          // signal -> history ring (ring null: none)
   std::vector<uint32_t> collected_states_;        // state signals taken this send round
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick

@@ -170,6 +170,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
       ss.write_errors.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
+    if (!is_event) AppendHistory(e.signal, rx_value_, value_seq, e.source_time_ns, now);
     ss.rx.fetch_add(1, std::memory_order_relaxed);
     ss.last_rx_ns.store(now, std::memory_order_relaxed);
     stored = true;

@@ -44,13 +44,14 @@ int ccomm_history_depth(const ccomm_client* c, ccomm_signal s) {
   return static_cast<int>(ccomm::client::SegmentOf(c).dir(static_cast<uint32_t>(s)).history_depth);
 }
 
-int ccomm_history_start(const ccomm_client* c, ccomm_signal s, int from_oldest, ccomm_history_cursor* cur) {
+int ccomm_history_start(const ccomm_client* c, ccomm_signal s, uint32_t back, ccomm_history_cursor* cur) {
   if (!ValidSignal(c, s) || !cur) return CCOMM_E_INVAL;
   const st::RingView v = ccomm::client::SegmentOf(c).history(static_cast<uint32_t>(s));
   if (!v.ring) return CCOMM_E_NOENT;
   st::RingCursor r;
   st::RingSubscribe(v, &r);
-  if (from_oldest) r.next = r.next > v.depth ? r.next - v.depth : 0;
+  const uint64_t kept = r.next < v.depth ? r.next : v.depth;  // values written, at most depth
+  r.next -= back < kept ? back : kept;
   memset(cur, 0, sizeof *cur);
   ToPublic(r, cur);
   return 0;

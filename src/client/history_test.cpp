@@ -89,11 +89,15 @@ TEST_F(HistoryTest, ReadsEveryValueInOrderThenEmpty) {
     EXPECT_EQ(info.overrun, 0u);
   }
   EXPECT_EQ(ccomm_history_read(c_, sp_, &cur, v, sizeof v, &info), CCOMM_EMPTY);
-  // A second, independent cursor from the oldest value kept sees them again.
+  // Independent cursors started back in the history see the values kept again.
   ccomm_history_cursor again;
-  ASSERT_EQ(ccomm_history_start(c_, sp_, 1, &again), 0);
+  ASSERT_EQ(ccomm_history_start(c_, sp_, 1000, &again), 0);
   ASSERT_EQ(ccomm_history_read(c_, sp_, &again, v, sizeof v, &info), CCOMM_FRESH);
   EXPECT_EQ(info.seq, 1u);
+  ASSERT_EQ(ccomm_history_start(c_, sp_, 1, &again), 0);
+  ASSERT_EQ(ccomm_history_read(c_, sp_, &again, v, sizeof v, &info), CCOMM_FRESH);
+  EXPECT_EQ(info.seq, 5u);
+  EXPECT_EQ(ccomm_history_read(c_, sp_, &again, v, sizeof v, &info), CCOMM_EMPTY);
 }
 
 TEST_F(HistoryTest, FallingBehindIsCountedExactly) {

@@ -86,7 +86,7 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   store::MarkStateForwarded(sv, version);
   if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
   uint64_t& last = last_tx_seq_[id];
-  if (!periodic && last && m.value_seq > last + 1)
+  if (!periodic && m.value_seq > last + 1)  // last = 0: none sent yet (daemon.cpp)
     segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
   last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);
@@ -118,6 +118,9 @@ void Daemon::SettleSteps(uint32_t steps_before) {
         if (p.open)
           p.writer.Rewrite(static_cast<uint16_t>(id), static_cast<uint32_t>(m.value_seq), m.source_time_ns, tx_value_);
       }
+      // The value taken for this round (and any written since) is replaced unsent: counted.
+      if (m.value_seq > last_tx_seq_[id])
+        segment_.stats(id).coalesced.fetch_add(m.value_seq - last_tx_seq_[id], std::memory_order_relaxed);
       last_tx_seq_[id] = m.value_seq;
     }
   }

@@ -211,9 +211,10 @@ typedef struct ccomm_history_info {
 /** N of signal `s` (> 0), 0 if it has no history ring (an event, not received here, or
     the node has no history=), CCOMM_E_INVAL for a bad handle or signal. */
 CCOMM_API int ccomm_history_depth(const ccomm_client* c, ccomm_signal s);
-/** Starts `cur` at the oldest value still kept (`from_oldest` != 0) or at the next one to
-    arrive. Returns 0, CCOMM_E_NOENT if `s` has no history ring, CCOMM_E_INVAL. */
-CCOMM_API int ccomm_history_start(const ccomm_client* c, ccomm_signal s, int from_oldest,
+/** Starts `cur` `back` values before the next one to arrive: 0 = only new values, 1 = the
+    newest value kept too, N (or more) = every value kept. Returns 0, CCOMM_E_NOENT if `s`
+    has no history ring, CCOMM_E_INVAL. */
+CCOMM_API int ccomm_history_start(const ccomm_client* c, ccomm_signal s, uint32_t back,
                                   ccomm_history_cursor* cur);
 /** Next value at `cur`: CCOMM_FRESH with the value (`len` = value_bytes) and `info`,
     CCOMM_EMPTY when there is none yet (`info` has only overrun and lost), CCOMM_E_CORRUPT

@@ -3,9 +3,10 @@
 the `mcap` package's own reader only (not ccomm's code), so a wrong writer cannot hide.
 `written` and `same` exit 0 when exact; 1 when a value is wrong, duplicated, out of order,
 missing without a gap field saying so, stored by the monitor's ccommd but not in the file,
-or lost without a ccommd counter; 3 when values are missing only because the producing
-ccommd replaced them before sending (its `coalesced` counter, exactly: issue 16's producer
-side); `same` 4 when the timing is outside the tolerance.
+or lost without a ccommd counter; 3 when values are missing that never reached the monitor,
+each counted by a ccommd (the producer's `coalesced`: replaced before it was sent, issue
+16's producer side; the monitor's `lost`: frames lost or dropped at its socket); `same` 4
+when the timing is outside the tolerance.
 
   recordcheck.py config SRC.xml OUT.xml            three-node config: SRC's two nodes + monitor
   recordcheck.py written FILE.mcap CONFIG NODE=SENT.json... -- NODE=STATS.json...
@@ -70,18 +71,23 @@ def load_stats(args: list) -> dict:
     return out
 
 
-def account(name: str, got: int, expected: int, stored: dict, producer: dict) -> str:
-    """Why values of `name` are missing from a recording: '' when every one is accounted
-    for by ccommd's counters (exactly), else what does not add up. The recorder must hold
-    every value the monitor's ccommd stored (its `rx`); the values the monitor never got
-    must be the ones the producer's ccommd replaced before sending them (`coalesced`)."""
+def account(name: str, got: int, expected: int, stored: dict, producer: dict, tally: list) -> str:
+    """Why values of `name` are missing from a recording: '' when every one is counted by
+    a ccommd, else what does not add up. The recorder must hold every value the monitor's
+    ccommd stored (its `rx`). Each value that never reached the monitor must be counted
+    there as a gap in the sequence (`lost`: frames lost or dropped at its socket, values
+    the producer replaced unsent), except values the producer replaced before the first
+    one the monitor got (no gap to see), which the producer counts (`coalesced`).
+    tally += [coalesced at the producer, lost on the way] (the missing values' causes)."""
     rx = stored[name]["rx"]
     if got != rx:
         return f"{name}: the file holds {got} values, the monitor's ccommd stored {rx}: the recorder lost values"
-    coalesced = producer[name]["coalesced"]
-    if expected - rx != coalesced:
-        return (f"{name}: {expected - rx} values never reached the monitor, but the producer's ccommd "
-                f"counted {coalesced} coalesced: values lost without being counted")
+    missing, gaps, coalesced = expected - rx, stored[name]["lost"], producer[name]["coalesced"]
+    if not gaps <= missing <= gaps + coalesced:
+        return (f"{name}: {missing} values never reached the monitor; its ccommd counted {gaps} gaps, "
+                f"the producer's {coalesced} coalesced: values lost without being counted")
+    tally[0] += min(missing, coalesced)
+    tally[1] += missing - min(missing, coalesced)
     return ""
 
 
@@ -89,12 +95,12 @@ def check_written(path: str, config: str, sent_files: list, stats: dict) -> int:
     """ccomm-latency writes its cycle number k = 1, 2, ... to every double its node
     produces, so on fresh daemons value == seq == k for k = 1..sent. sent_files: NODE=JSON
     (ccomm-latency's output). stats: load_stats() of the monitor and the producers.
-    0: every value in the file; 3: values missing, each one replaced at its producer before
-    ccommd sent it (counted `coalesced` there) and the file = what the monitor stored;
-    1: anything else (a wrong, duplicated or unordered value, a value the monitor stored
+    0: every value in the file; 3: values missing that never reached the monitor, each one
+    counted by a ccommd (see account), and the file = what the monitor stored; 1: anything else (a wrong, duplicated or unordered value, a value the monitor stored
     that the file lacks, a value lost without a counter)."""
     got = read_values(path)
     wrong = missing = total = nsig = 0
+    tally = [0, 0]
     for arg in sent_files:
         node, sf = arg.split("=", 1)
         sent, names = json.load(open(sf))["sent"], produced_by(config, node)
@@ -107,7 +113,7 @@ def check_written(path: str, config: str, sent_files: list, stats: dict) -> int:
             unordered = sum(1 for a, b in zip(seqs, seqs[1:]) if b <= a)
             unaccounted = sum(1 for a, b in zip(vals, vals[1:]) if b[0] - a[0] - 1 != b[4])
             miss = sent - len(vals)
-            why = account(name, len(vals), sent, stats["monitor"], stats[node])
+            why = account(name, len(vals), sent, stats["monitor"], stats[node], tally)
             if bad or unordered or unaccounted or why:
                 wrong += 1
                 print(f"# {name}: WRONG: {len(bad)} values != seq or out of 1..{sent} (e.g. {bad[:2]}), "
@@ -115,10 +121,10 @@ def check_written(path: str, config: str, sent_files: list, stats: dict) -> int:
             elif miss:
                 gone = sorted(set(range(1, sent + 1)) - set(seqs))
                 print(f"# {name}: {len(vals)} of {sent} values; missing seq {gone[:8]}"
-                      f"{' ...' if len(gone) > 8 else ''}: coalesced by {node}'s ccommd, never sent")
+                      f"{' ...' if len(gone) > 8 else ''}: never reached the monitor (counted by ccommd)")
             missing += miss
-    print(f"# recording: {total} values of {nsig} signals, {missing} missing (coalesced at the producer), "
-          f"{wrong} signals wrong")
+    print(f"# recording: {total} values of {nsig} signals, {wrong} signals wrong, {missing} values missing: "
+          f"{tally[0]} coalesced at the producer, {tally[1]} lost on the way (frames lost, socket drops)")
     if wrong:
         return 1
     return 3 if missing else 0
@@ -136,6 +142,7 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
         return 1
     producer = {n: node for node in ("control", "planner") for n in produced_by(config, node)}
     wrong = missing = n = 0
+    tally = [0, 0]
     errs = []
     for name in sorted(a):
         va, vb = a[name], b[name]
@@ -143,7 +150,7 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
         bad = [v for v in vb if not 1 <= v[0] <= len(va) or v[1] != va[v[0] - 1][1]]
         unordered = sum(1 for x, y in zip(seqs, seqs[1:]) if y <= x)
         unaccounted = sum(1 for x, y in zip(vb, vb[1:]) if y[0] - x[0] - 1 != y[4])
-        why = account(name, len(vb), len(va), stats["monitor"], stats[producer[name]])
+        why = account(name, len(vb), len(va), stats["monitor"], stats[producer[name]], tally)
         if bad or unordered or unaccounted or why:
             wrong += 1
             print(f"# {name}: WRONG: {len(bad)} replayed values differ from the recorded ones "
@@ -151,7 +158,7 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
             continue
         if len(vb) != len(va):
             print(f"# {name}: {len(vb)} of {len(va)} replayed values in the second recording; missing "
-                  f"{sorted(set(range(1, len(va) + 1)) - set(seqs))[:8]}: coalesced at the producer, never sent")
+                  f"{sorted(set(range(1, len(va) + 1)) - set(seqs))[:8]}: never reached the monitor (counted by ccommd)")
         missing += len(va) - len(vb)
         if not vb:
             continue
@@ -163,7 +170,8 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
     errs.sort()
     worst = errs[-1] if errs else 0
     p99 = errs[int(0.99 * (len(errs) - 1))] if errs else 0
-    print(f"# replay: {n} values equal and in order, {missing} missing (coalesced at the producer); "
+    print(f"# replay: {n} values equal and in order, {missing} missing ({tally[0]} coalesced at the producer, "
+          f"{tally[1]} lost on the way); "
           f"timing error p99 {p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance {tol_ms} ms)")
     if wrong:
         return 1

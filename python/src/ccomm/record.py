@@ -71,8 +71,9 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
                    help="uncompressed chunk size (default 1 MiB; chunks also close every second)")
     p.add_argument("--priority", type=int, default=0, metavar="N",
-                   help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); a state "
-                        "value replaced before the loop reads it is missed (counted as a gap)")
+                   help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); below "
+                        "ccommd's. Without a history tap a state value replaced before the loop "
+                        "reads it is missed (counted as a gap)")
     p.add_argument("--progress", choices=["auto", "lines", "none"], default="auto",
                    help="progress on stderr: in place on a terminal (auto), a line every 5 s, none")
     p.add_argument("-q", "--quiet", action="store_true", help="same as --progress none")

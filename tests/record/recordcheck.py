@@ -31,14 +31,14 @@ from mcap.reader import make_reader
 
 def make_config(src: str, out: str) -> None:
     """The demo's setup-simulation with a third node 'monitor' that consumes every signal
-    and keeps the last 1024 values of each (its history tap: the recorder gets every one),
+    and keeps the last 4096 values of each (its history tap: the recorder gets every one),
     all on loopback UDP (127.0.0.1-3 inside the suite's own network namespace)."""
     x = open(src).read()
     x = x.replace('ip="10.42.0.1"', 'ip="127.0.0.1"').replace('ip="10.42.0.2"', 'ip="127.0.0.2"')
     x = x.replace('interface="eth0"', 'interface="lo"')
     x = x.replace('consumers="planner"', 'consumers="planner,monitor"')
     x = x.replace('consumers="control"', 'consumers="control,monitor"')
-    monitor = ('  <node name="monitor" interface="lo" ip="127.0.0.3" transport="udp" history="1024">\n'
+    monitor = ('  <node name="monitor" interface="lo" ip="127.0.0.3" transport="udp" history="4096">\n'
                '    <realtime mlockall="true" priority="80"/>\n  </node>\n')
     x = re.sub(r"(\n  <!--[^\n]*\n  <signal )", "\n" + monitor + r"\1", x, count=1)
     if "monitor" not in x.split("<signal", 1)[0]:

@@ -114,14 +114,6 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
   history_.assign(n, store::RingView());
   for (uint32_t i = 0; i < n; ++i) history_[i] = segment_.history(i);
-  // Coalescing (values replaced before they were sent) is counted from what each state
-  // holds now: values written before this ccommd started are not its to count.
-  for (uint32_t i = 0; i < n; ++i) {
-    store::SlotMeta held;
-    if (!(segment_.dir(i).flags & store::kSigEvent) &&
-        store::StateRead(segment_.state(i), tx_value_, &held) == store::StoreResult::kOk)
-      last_tx_seq_[i] = held.value_seq;
-  }
   for (uint32_t p = 0; p < m; ++p) segment_.peer(p).alive.store(0);  // a re-adopted segment's are stale
   if (adopted_) {
     // Writers that died while this ccommd was down may have left slots half-written.
@@ -135,6 +127,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       fwd_cursors_[i].next = store::RingForwardCursor(segment_.ring(static_cast<uint32_t>(i)));
     }
   }
+  PrepareRxTx();
 
   bool any_peer = false;
   for (const PeerTx& pt : peers_tx_) any_peer = any_peer || pt.active;

@@ -180,6 +180,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
       }
     } else {
       store::StateWriteSingle(rs->state, value, store::SlotMeta{value_seq, e.source_time_ns(), now});
+      AppendHistory(id, value, value_seq, e.source_time_ns(), now);
     }
     rs->stats->rx.store(rs->stats->rx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     rs->stats->last_rx_ns.store(now, std::memory_order_relaxed);

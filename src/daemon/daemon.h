@@ -107,7 +107,12 @@ class Daemon {
   void CountBadEntry(uint16_t signal, const wire::FrameHeader& h);
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
-  void SettleSteps(uint32_t steps_before);
+  void SettleSteps(uint32_t steps_before, uint64_t now);
+  /// Adds the values of state `id` written after `last_sent` and before the newest one
+  /// (value_seq `newest`) that its slots still hold, oldest first; returns how many of
+  /// them are gone (replaced before ccommd took them: coalesced).
+  uint64_t CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
+                   uint64_t now);
   void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
                 const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
@@ -166,6 +171,7 @@ class Daemon {
   uint64_t heartbeat_ns_ = 0, peer_timeout_ns_ = 0;
   uint64_t idle_sleep_ns_ = 0;  // longest sleep of an idle send loop
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
+  alignas(8) uint8_t tx_older_[kMaxValueBytes];  // CatchUp's copy of an older value
   alignas(8) uint8_t rx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_buf_[2048];
 };

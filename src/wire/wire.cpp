@@ -223,23 +223,6 @@ bool FrameWriter::AddPreparedGeneric(uint64_t prefix, uint32_t seq, uint64_t sou
   return true;
 }
 
-bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value) {
-  if (len_ < kHeaderSize) return false;
-  size_t off = kHeaderSize;
-  for (uint16_t i = 0; i < count_; ++i) {  // bounded: the entries this writer added
-    uint8_t* p = buf_ + off;
-    const size_t value_len = Load<uint16_t>(p + kEOffLen);
-    if (Load<uint16_t>(p + kEOffSignal) == signal && !(p[kEOffFlags] & kEntryEvent)) {
-      Store<uint32_t>(p + kEOffSeq, seq);
-      Store<uint64_t>(p + kEOffTime, source_time_ns);
-      EncodeValue(p + kEntryHeaderSize, value, ValueTypeSize(p[kEOffType]), Load<uint16_t>(p + kEOffCount));
-      return true;
-    }
-    off += EntrySize(value_len);
-  }
-  return false;
-}
-
 size_t FrameWriter::Finish() {
   if (len_ < kHeaderSize) return 0;
   if (count_ == 0 && !(buf_[kOffFlags] & kFlagHeartbeat)) return 0;

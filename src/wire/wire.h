@@ -139,9 +139,6 @@ class FrameWriter {
     ++count_;
     return true;
   }
-  /// Replaces the value, seq and source time of the (non-event) entry of `signal` already
-  /// in this frame, re-encoded as Add does (same type and count). False if absent.
-  bool Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value);
   /// Writes entry_count / payload_len into the header; returns the frame length
   /// without any auth tag, or 0 if Begin failed (cap < kHeaderSize, unknown flag bits)
   /// or a frame without kFlagHeartbeat has no entry (such a frame is invalid).

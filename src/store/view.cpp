@@ -12,6 +12,7 @@
 #include <cstdlib>
 
 #include "common/platform.h"
+#include "store/word_copy.h"  // the seqlock fences (and their TSan form)
 
 namespace ccomm {
 namespace store {
@@ -119,16 +120,18 @@ ViewRow* View::Row(uint32_t n, uint32_t s) const {
 void View::BeginWrite(uint32_t node) {
   ViewNode* v = Node(node);
   v->seq.store(v->seq.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);  // odd seq before any data store
+  SeqlockWriterFence();  // odd seq before any data store
 }
+
+void View::SetNodeWord(uint32_t node, ViewNodeWord w, uint64_t v) { Node(node)->w[w].store(v, kMetaStore); }
 
 void View::SetRow(uint32_t node, uint32_t signal, uint8_t role, uint8_t flags, uint32_t rate_mhz, uint64_t lost,
                   uint32_t age_ms, uint64_t rx_ns) {
   ViewRow* r = Row(node, signal);
-  r->w[0].store(1u | uint64_t{role} << 8 | uint64_t{flags} << 16 | uint64_t{rate_mhz} << 32, std::memory_order_relaxed);
-  r->w[1].store(lost, std::memory_order_relaxed);
-  r->w[2].store(age_ms, std::memory_order_relaxed);
-  r->w[3].store(rx_ns, std::memory_order_relaxed);
+  r->w[0].store(1u | uint64_t{role} << 8 | uint64_t{flags} << 16 | uint64_t{rate_mhz} << 32, kMetaStore);
+  r->w[1].store(lost, kMetaStore);
+  r->w[2].store(age_ms, kMetaStore);
+  r->w[3].store(rx_ns, kMetaStore);
 }
 
 void View::EndWrite(uint32_t node) {
@@ -142,8 +145,8 @@ bool View::ReadNode(uint32_t node, ViewNodeCopy* out) const {
   for (int i = 0; i < kReadTries; ++i) {
     const uint32_t s1 = v->seq.load(std::memory_order_acquire);
     if (s1 & 1u) continue;
-    for (uint32_t k = 0; k < kVwNodeWords; ++k) out->w[k] = v->w[k].load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
+    for (uint32_t k = 0; k < kVwNodeWords; ++k) out->w[k] = v->w[k].load(kMetaLoad);
+    SeqlockReaderFence();
     if (v->seq.load(std::memory_order_relaxed) == s1) return true;
   }
   return false;
@@ -156,11 +159,11 @@ bool View::ReadRow(uint32_t node, uint32_t signal, ViewRowCopy* out) const {
   for (int i = 0; i < kReadTries; ++i) {
     const uint32_t s1 = v->seq.load(std::memory_order_acquire);
     if (s1 & 1u) continue;
-    const uint64_t w0 = r->w[0].load(std::memory_order_relaxed);
-    out->lost = r->w[1].load(std::memory_order_relaxed);
-    out->age_ms = static_cast<uint32_t>(r->w[2].load(std::memory_order_relaxed));
-    out->rx_ns = r->w[3].load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
+    const uint64_t w0 = r->w[0].load(kMetaLoad);
+    out->lost = r->w[1].load(kMetaLoad);
+    out->age_ms = static_cast<uint32_t>(r->w[2].load(kMetaLoad));
+    out->rx_ns = r->w[3].load(kMetaLoad);
+    SeqlockReaderFence();
     if (v->seq.load(std::memory_order_relaxed) != s1) continue;
     out->present = (w0 & 1u) != 0;
     out->role = static_cast<uint8_t>(w0 >> 8);

@@ -99,7 +99,7 @@ class View {
 
   // Writer (ccommd): Begin, Set*, End per node.
   void BeginWrite(uint32_t node);
-  void SetNodeWord(uint32_t node, ViewNodeWord w, uint64_t v) { Node(node)->w[w].store(v, std::memory_order_relaxed); }
+  void SetNodeWord(uint32_t node, ViewNodeWord w, uint64_t v);
   void SetRow(uint32_t node, uint32_t signal, uint8_t role, uint8_t flags, uint32_t rate_mhz, uint64_t lost,
               uint32_t age_ms, uint64_t rx_ns);
   void EndWrite(uint32_t node);

@@ -294,7 +294,13 @@ def main():
                     entries=[Entry(1, "double", [float(i) for i in range(177)])]).data()
         assert len(big) == 1472
         seeds = [(v.name, v.data()) for v in vs]
-        seeds += [("max-frame", big), ("eth-padded-heartbeat", vs[0].data().ljust(46, b"\0"))]
+        full = Frame("max-summary", "ok", sender=1, dest=0xFFFF, config_hash=HASH, seq=1, time_ns=1,
+                     flags=F_SUMMARY | F_AUTH, tag=TAG,
+                     summary=Summary(0, 2, 1000, 1, 0x7, (1, 2, 3, 4, 5),
+                                     [(i, 1 + i % 2, i % 4, i, i, i) for i in range(56)])).data()
+        assert len(full) == 32 + 64 + 56 * 24 + 16
+        seeds += [("max-frame", big), ("eth-padded-heartbeat", vs[0].data().ljust(46, b"\0")),
+                  ("max-summary", full)]
         os.makedirs(args.corpus, exist_ok=True)
         for name, data in seeds:
             with open(os.path.join(args.corpus, name + ".bin"), "wb") as f:

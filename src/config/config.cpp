@@ -59,6 +59,12 @@ std::string CanonicalForm(const SystemConfig& cfg) {
   std::string s = "ccomm-config 1\n";
   s += "network " + std::to_string(cfg.network.ethertype) + " " +
        std::to_string(cfg.network.udp_port) + "\n";
+  // Only when not the default, so files without fanout= keep their hash.
+  if (cfg.network.fanout == Fanout::kMulticast) {
+    const uint8_t* b = cfg.network.multicast_base;
+    s += "fanout multicast " + std::to_string(b[0]) + "." + std::to_string(b[1]) + "." +
+         std::to_string(b[2]) + "." + std::to_string(b[3]) + "\n";
+  }
   for (const NodeConfig& n : cfg.nodes) s += "node " + n.name + "\n";
   for (const SignalConfig& sig : cfg.signals) {
     std::vector<uint32_t> consumers = sig.consumers;

@@ -24,6 +24,9 @@ bool ParseValueType(const std::string& name, ValueType* out);
 
 enum class SignalKind : uint8_t { kState = 0, kEvent = 1 };
 enum class TransportKind : uint8_t { kRaw = 0, kUdp = 1 };
+/// How a producing node reaches its consumers: one frame per consumer (unicast), or one
+/// frame per cycle to the node's own multicast group that its consumers join.
+enum class Fanout : uint8_t { kUnicast = 0, kMulticast = 1 };
 
 constexpr uint32_t kMaxSignals = 4096;
 constexpr uint32_t kMaxNodes = 64;
@@ -45,7 +48,9 @@ struct NodeConfig {
   bool has_mac = false;
   uint8_t mac[6] = {};         // unicast destination for raw frames; broadcast if !has_mac
   std::string ip;              // IPv4 unicast address for UDP (dotted quad), may be empty
-  std::string multicast;       // optional IPv4 multicast group for UDP
+  std::string multicast;       // optional IPv4 multicast group for UDP (unicast fan-out)
+  std::vector<std::string> monitor;  // monitor="*" or "a*,b*": consumes every matching signal
+                                     // produced elsewhere (expanded into the consumer lists)
   TransportKind transport = TransportKind::kRaw;
   RealtimeConfig realtime;
   int line = 0;                // line of <node> in the file, for messages
@@ -78,6 +83,8 @@ struct NetworkConfig {
   uint32_t summary_ms = 1000;  // node summaries for `ccomm stats --all`: one full round per this
                                // many ms, at most one frame per 100 ms; 0 = none (local policy)
   std::string auth_key_file;   // empty = no authentication
+  Fanout fanout = Fanout::kUnicast;
+  uint8_t multicast_base[4] = {239, 255, 67, 0};  // UDP group of node n: base + n
 };
 
 // <ros2>: what ccomm-ros2 on one node bridges (local policy, not in the hash).

@@ -820,5 +820,50 @@ INSTANTIATE_TEST_SUITE_P(Files, BadConfig, ::testing::ValuesIn(BadFiles()), Case
 
 TEST(BadConfigFiles, AtLeastTwenty) { EXPECT_GE(BadFiles().size(), 20u); }
 
+
+// ------------------------------------------------------------- fan-out, monitors
+
+TEST(Fanout, MonitorAndMulticastAreHashedAsDocumented) {
+  // docs/config.md: the monitor is expanded into the consumer lists; fanout="multicast"
+  // adds one line. Computed independently (Python) from that canonical form:
+  //   ccomm-config 1\nnetwork 34997 47800\nfanout multicast 239.255.67.0\n
+  //   node client\nnode server\nnode logger\nnode spare\n
+  //   signal value double 1 state client server,logger,spare\n
+  //   signal cmd int32 4 event server client,spare\n
+  const std::string x = Replace(Replace(kHashBase, "udp_port=\"47800\"/>", "udp_port=\"47800\" fanout=\"multicast\"/>"),
+                                "<node name=\"spare\" interface=\"eth0\"/>",
+                                "<node name=\"spare\" interface=\"eth0\" monitor=\"*\"/>");
+  SystemConfig cfg = MustParse(x);
+  EXPECT_EQ(cfg.network.fanout, Fanout::kMulticast);
+  EXPECT_EQ(cfg.signals[0].consumers, (std::vector<uint32_t>{1, 2, 3}));
+  EXPECT_EQ(cfg.signals[1].consumers, (std::vector<uint32_t>{0, 3}));
+  EXPECT_EQ(cfg.hash, 0xbbe8f4cau);
+  // The default (unicast, no monitor) keeps the hash every existing file has.
+  EXPECT_EQ(HashOf(Replace(kHashBase, "udp_port=\"47800\"/>", "udp_port=\"47800\" fanout=\"unicast\"/>")), 0x35465836u);
+}
+
+TEST(Fanout, MonitorPatternsSelectSignalsAndNeverTheirOwn) {
+  SystemConfig cfg = MustParse(TwoNodes(
+      "<node name=\"mon\" interface=\"eth0\" monitor=\"arm_*, cam_?\"/>\n"
+      "<signal name=\"arm_q\" type=\"double\" producer=\"a\"/>\n"
+      "<signal name=\"cam_1\" type=\"double\" producer=\"b\" consumers=\"mon\"/>\n"
+      "<signal name=\"cam_10\" type=\"double\" producer=\"a\"/>\n"
+      "<signal name=\"arm_mon\" type=\"double\" producer=\"mon\" consumers=\"a\"/>\n"));
+  ASSERT_EQ(cfg.nodes[2].monitor, (std::vector<std::string>{"arm_*", "cam_?"}));
+  EXPECT_EQ(cfg.signals[0].consumers, (std::vector<uint32_t>{2}));     // matched
+  EXPECT_EQ(cfg.signals[1].consumers, (std::vector<uint32_t>{2}));     // listed once, not twice
+  EXPECT_TRUE(cfg.signals[2].consumers.empty());                      // cam_? is one character
+  EXPECT_EQ(cfg.signals[3].consumers, (std::vector<uint32_t>{0}));     // its own: not consumed
+}
+
+TEST(Fanout, BadValuesSayWhatIsExpected) {
+  EXPECT_NE(MustFail(TwoNodes("<network fanout=\"broadcast\"/>")).find("unknown fanout 'broadcast' (expected unicast or multicast)"),
+            std::string::npos);
+  EXPECT_NE(MustFail(TwoNodes("<network multicast_base=\"10.0.0.0\"/>")).find("is not in 224.0.0.0/4"), std::string::npos);
+  EXPECT_NE(MustFail(TwoNodes("<network multicast_base=\"239.1.1.250\"/>")).find("must leave room"), std::string::npos);
+  EXPECT_NE(MustFail(TwoNodes("<node name=\"m\" interface=\"eth0\" monitor=\"a,,b\"/>")).find("empty pattern in monitor"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace ccomm

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Checks across elements: unique names and addresses, producers and consumers that
 // exist, transports that match.
+#include <fnmatch.h>
+
 #include <algorithm>
 #include <cstring>
 
@@ -57,6 +59,23 @@ void Parser::CrossCheck(SystemConfig* cfg) {
   }
 
   std::vector<std::pair<uint32_t, uint32_t>> mixed;  // node pairs already reported
+  // ccommd opens one transport, its own node's, and reaches every peer with it
+  // (daemon/transport.h), so nodes that exchange signals must agree on it.
+  // Reported once per pair of nodes.
+  auto check_transport = [&](const SignalConfig& s, int producer, uint32_t c, int line) {
+    if (producer < 0) return;
+    const NodeConfig& pn = cfg->nodes[static_cast<size_t>(producer)];
+    const NodeConfig& cn = cfg->nodes[c];
+    if (pn.transport == cn.transport) return;
+    std::pair<uint32_t, uint32_t> pair(std::min<uint32_t>(producer, c), std::max<uint32_t>(producer, c));
+    if (std::find(mixed.begin(), mixed.end(), pair) != mixed.end()) return;
+    mixed.push_back(pair);
+    auto tname = [](TransportKind k) { return k == TransportKind::kUdp ? "udp" : "raw"; };
+    Err(line, "signal " + Quote(s.name) + " goes from " + tname(pn.transport) + " node " +
+                  Quote(pn.name) + " to " + tname(cn.transport) + " node " + Quote(cn.name) +
+                  "; nodes that exchange signals need the same transport= (ccommd uses " +
+                  "one transport for all its peers)");
+  };
   for (size_t i = 0; i < cfg->signals.size(); ++i) {
     SignalConfig& s = cfg->signals[i];
     const SignalRefs& r = refs_[i];
@@ -85,22 +104,20 @@ void Parser::CrossCheck(SystemConfig* cfg) {
         continue;
       }
       s.consumers.push_back(static_cast<uint32_t>(c));
-      // ccommd opens one transport, its own node's, and reaches every peer with it
-      // (daemon/transport.h), so nodes that exchange signals must agree on it.
-      // Reported once per pair of nodes.
-      if (producer < 0) continue;
-      const NodeConfig& pn = cfg->nodes[static_cast<size_t>(producer)];
-      const NodeConfig& cn = cfg->nodes[static_cast<size_t>(c)];
-      if (pn.transport != cn.transport) {
-        std::pair<uint32_t, uint32_t> pair(std::min<uint32_t>(producer, c), std::max<uint32_t>(producer, c));
-        if (std::find(mixed.begin(), mixed.end(), pair) != mixed.end()) continue;
-        mixed.push_back(pair);
-        auto tname = [](TransportKind k) { return k == TransportKind::kUdp ? "udp" : "raw"; };
-        Err(line, "signal " + Quote(s.name) + " goes from " + tname(pn.transport) + " node " +
-                      Quote(pn.name) + " to " + tname(cn.transport) + " node " + Quote(cn.name) +
-                      "; nodes that exchange signals need the same transport= (ccommd uses " +
-                      "one transport for all its peers)");
-      }
+      check_transport(s, producer, static_cast<uint32_t>(c), line);
+    }
+    // Monitor nodes consume every matching signal produced elsewhere, without being
+    // listed (recorders, bridges, dashboards); the expanded lists are what is hashed.
+    for (uint32_t m = 0; m < cfg->nodes.size(); ++m) {
+      const NodeConfig& mn = cfg->nodes[m];
+      if (mn.monitor.empty() || static_cast<int>(m) == producer || producer < 0) continue;
+      if (std::find(s.consumers.begin(), s.consumers.end(), m) != s.consumers.end()) continue;
+      const bool match = std::any_of(mn.monitor.begin(), mn.monitor.end(), [&](const std::string& p) {
+        return fnmatch(p.c_str(), s.name.c_str(), 0) == 0;
+      });
+      if (!match) continue;
+      s.consumers.push_back(m);
+      check_transport(s, producer, m, mn.line);
     }
   }
   CrossCheckRos2(cfg);

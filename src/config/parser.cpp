@@ -195,7 +195,8 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
 }
 
 void Parser::Network(const Node* n, NetworkConfig* net) {
-  Element e(n, {"ethertype", "udp_port", "heartbeat_ms", "peer_timeout_ms", "summary_ms", "auth_key_file"},
+  Element e(n, {"ethertype", "udp_port", "heartbeat_ms", "peer_timeout_ms", "summary_ms", "auth_key_file", "fanout",
+                "multicast_base"},
             &diag_);
   CheckNoText(n, &diag_);
   if (n->first_node(nullptr))
@@ -221,6 +222,26 @@ void Parser::Network(const Node* n, NetworkConfig* net) {
       net->summary_ms != 0 && net->summary_ms < kMinSummaryMs)
     Err(e.Get("summary_ms")->line, "summary_ms " + std::to_string(net->summary_ms) + " is below " +
                                        std::to_string(kMinSummaryMs) + " (0 turns summaries off)");
+  if (const AttrValue* a = e.Get("fanout")) {
+    if (a->value == "unicast")
+      net->fanout = Fanout::kUnicast;
+    else if (a->value == "multicast")
+      net->fanout = Fanout::kMulticast;
+    else
+      Err(a->line, "unknown fanout " + Quote(a->value) + " (expected unicast or multicast)");
+  }
+  if (const AttrValue* a = e.Get("multicast_base")) {
+    uint8_t q[4];
+    if (!ParseIpv4(a->value, q))
+      Err(a->line, "invalid multicast_base " + Quote(a->value) + " (expected an IPv4 address like 239.255.67.0)");
+    else if (q[0] < 224 || q[0] > 239)
+      Err(a->line, "multicast_base " + a->value + " is not in 224.0.0.0/4");
+    else if (q[3] > 256 - kMaxNodes)
+      Err(a->line, "multicast_base " + a->value + ": its last byte must leave room for " +
+                       std::to_string(kMaxNodes) + " node groups (at most " + std::to_string(256 - kMaxNodes) + ")");
+    else
+      std::copy(q, q + 4, net->multicast_base);
+  }
   if (const AttrValue* a = e.Get("auth_key_file")) {
     if (a->value.empty())
       Err(a->line, "empty auth_key_file (omit it to disable authentication)");
@@ -232,7 +253,7 @@ void Parser::Network(const Node* n, NetworkConfig* net) {
 }
 
 void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
-  Element e(n, {"name", "interface", "mac", "ip", "multicast", "transport"}, &diag_);
+  Element e(n, {"name", "interface", "mac", "ip", "multicast", "transport", "monitor"}, &diag_);
   node->line = e.line();
   Name(e, "node", &node->name);
   CheckNoText(n, &diag_);
@@ -305,6 +326,22 @@ void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
       Err(a->line, "multicast " + a->value + " is not in 224.0.0.0/4");
     } else {
       node->multicast = a->value;
+    }
+  }
+  if (const AttrValue* a = e.Get("monitor")) {
+    // Comma-separated glob patterns on signal names (fnmatch: * ? [...]).
+    std::string item;
+    for (size_t i = 0; i <= a->value.size(); ++i) {
+      const char c = i < a->value.size() ? a->value[i] : ',';
+      if (c != ',') {
+        if (c != ' ') item += c;
+        continue;
+      }
+      if (item.empty())
+        Err(a->line, "empty pattern in monitor " + Quote(a->value) + " (expected e.g. \"*\" or \"arm_*,cam_*\")");
+      else
+        node->monitor.push_back(item);
+      item.clear();
     }
   }
   // A node that is alone in the file talks to nobody (shared memory only), so it needs

@@ -33,7 +33,9 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
 
   // Who do we talk to, and which signals go where.
-  peers_tx_ = std::vector<PeerTx>(m);
+  peers_tx_ = std::vector<PeerTx>(m + 1);  // + the group stream
+  group_tx_ = static_cast<uint32_t>(m);
+  fanout_multicast_ = cfg.network.fanout == Fanout::kMulticast;
   peers_rx_.assign(m, PeerRx());
   consumers_.assign(n, {});
   due_ns_.assign(n, 0);
@@ -49,8 +51,10 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     bool consumed_here = false;
     for (uint32_t c : s.consumers) {
       if (here && c != node_id) {
-        consumers_[i].push_back(c);
         peers_tx_[c].active = true;
+        // Multicast fan-out: once, to our group, whatever the number of consumers.
+        if (!fanout_multicast_) consumers_[i].push_back(c);
+        else if (consumers_[i].empty()) consumers_[i].push_back(group_tx_);
       }
       if (c == node_id) consumed_here = true;
     }
@@ -60,6 +64,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     }
     if (here && !consumers_[i].empty() && s.period_us) periodic_.push_back(static_cast<uint32_t>(i));
   }
+  std::vector<PeerAddress> groups;  // multicast fan-out: the groups of the peers we exchange with
   for (uint32_t p = 0; p < m; ++p) {
     PeerTx& pt = peers_tx_[p];
     if (!pt.active) continue;
@@ -75,11 +80,25 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       return -EINVAL;
     }
     pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
+    pt.dest = static_cast<uint16_t>(p);
+    pt.sends = !fanout_multicast_;
+    if (pt.sends) senders_.push_back(p);
+    if (fanout_multicast_) groups.push_back(GroupAddressFor(cfg.network, p, kind));
     // UDP frames must come from the peer's own address (rule 2); raw frames carry no
     // address worth checking (any station can send any source MAC).
     if (kind == TransportKind::kUdp && !cfg.nodes[p].ip.empty())
       inet_pton(AF_INET, cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
   }
+
+  if (fanout_multicast_ && !groups.empty()) {
+    PeerTx& g = peers_tx_[group_tx_];
+    g.active = g.sends = true;
+    g.dest = wire::kDestAll;
+    g.addr = GroupAddressFor(cfg.network, node_id, kind);
+    g.writer = wire::FrameWriter(g.buf, sizeof g.buf);
+    senders_.push_back(group_tx_);
+  }
+  senders_.shrink_to_fit();
 
   replay_.assign(m, auth::ReplayWindow());
   if (!cfg.network.auth_key_file.empty()) {
@@ -116,6 +135,10 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     r = kind == TransportKind::kRaw ? OpenRawTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error)
                                     : OpenUdpTransport(cfg.network, self, opt.recv_timeout_ms, &transport_, error);
     if (r != 0) return r;
+    if (fanout_multicast_) {
+      r = transport_.JoinGroups(groups.data(), groups.size(), error);
+      if (r != 0) return r;
+    }
   }
   r = view_.Start(cfg, node_id, kind, opt.force_udp, &segment_, &transport_, &auth_, gid, error);
   if (r != 0) return r;
@@ -147,7 +170,7 @@ void Daemon::Supervise(uint64_t now) {
       socket_drops_seen_ = drops;
     }
   }
-  for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
+  for (uint32_t p = 0; p < peers_rx_.size(); ++p) {
     if (!peers_tx_[p].active) continue;
     store::PeerStats& ps = segment_.peer(p);
     // alive before last: the receive thread stores last, then sets alive (release), so a

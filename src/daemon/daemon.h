@@ -56,8 +56,12 @@ class Daemon {
   bool adopted_segment() const { return adopted_; }
 
  private:
+  // A frame stream this node sends: to one peer (unicast fan-out), or, with
+  // fanout="multicast", the one stream to this node's group (index group_tx_).
   struct PeerTx {
     bool active = false;        // we exchange signals with this node
+    bool sends = false;         // frames go out on this stream (data and heartbeats)
+    uint16_t dest = 0;          // header dest: the peer's id, or wire::kDestAll for the group
     PeerAddress addr;
     uint32_t seq = 0;
     uint64_t last_tx_ns = 0;
@@ -118,9 +122,12 @@ class Daemon {
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};
 
   // Preallocated in Start().
-  std::vector<PeerTx> peers_tx_;
+  std::vector<PeerTx> peers_tx_;                  // [node id] and, last, the group stream
+  std::vector<uint32_t> senders_;                 // indices of peers_tx_ that send
+  uint32_t group_tx_ = 0;                         // index of the group stream (multicast fan-out)
+  bool fanout_multicast_ = false;
   std::vector<PeerRx> peers_rx_;
-  std::vector<std::vector<uint32_t>> consumers_;  // signal -> remote consumer node ids
+  std::vector<std::vector<uint32_t>> consumers_;  // signal -> the streams (peers_tx_) it goes out on
   std::vector<uint32_t> periodic_;                // forwarded periodic signal ids
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor

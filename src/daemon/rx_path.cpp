@@ -152,8 +152,13 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     }
     const store::SignalDirectoryEntry& d = segment_.dir(e.signal);
     const SignalConfig& sc = cfg_->signals[e.signal];
-    if (!(d.flags & store::kSigConsumedHere) || sc.producer != h.sender) {
-      Count(store::kFramesNotForUs);
+    if (sc.producer != h.sender) {
+      Count(store::kFramesNotForUs);  // the sender does not produce it: not a valid entry
+      continue;
+    }
+    if (!(d.flags & store::kSigConsumedHere)) {
+      // A group frame carries every consumer's entries: skipping others' is normal.
+      if (h.dest != wire::kDestAll || !fanout_multicast_) Count(store::kFramesNotForUs);
       continue;
     }
     bool is_event = (d.flags & store::kSigEvent) != 0;

@@ -36,6 +36,11 @@ struct TransportOps {
   ssize_t (*recv)(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from);
   /// Frames the kernel dropped before ccommd read them (cumulative); 0 or -errno.
   int (*socket_drops)(Transport* t, uint32_t* drops);
+  /// Multicast fan-out: receive the groups `groups[0..n)` (addresses from GroupAddressFor)
+  /// and, where the transport can, nothing of other ccomm groups (raw: a socket filter,
+  /// so frames of producers this node does not exchange with never wake ccommd). Start-up
+  /// only; 0 or -errno with a message in `error`.
+  int (*join_groups)(Transport* t, const PeerAddress* groups, size_t n, std::string* error);
   /// Closes the socket and frees the state.
   void (*close)(Transport* t);
 };
@@ -47,6 +52,7 @@ struct Transport {
   int Send(const PeerAddress& to, const uint8_t* f, size_t n) { return ops->send(this, to, f, n); }
   ssize_t Recv(uint8_t* b, size_t cap, PeerAddress* from) { return ops->recv(this, b, cap, from); }
   int SocketDrops(uint32_t* drops) { return ops ? ops->socket_drops(this, drops) : -EBADF; }
+  int JoinGroups(const PeerAddress* g, size_t n, std::string* error) { return ops->join_groups(this, g, n, error); }
   void Close() {
     if (ops) ops->close(this);
     ops = nullptr;
@@ -57,10 +63,17 @@ struct Transport {
 /// Opens the transport `self` is configured for. `recv_timeout_ms` bounds Recv so the
 /// receive thread can notice shutdown. Returns 0, or -errno with a message in `error`
 /// that says what to do (e.g. missing CAP_NET_RAW).
+/// With fanout="multicast" the UDP socket binds to any address (to receive groups).
 int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
                      Transport* out, std::string* error);
 int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
                      Transport* out, std::string* error);
+
+/// Multicast fan-out: the group node `node_id` sends to (docs/protocol.md, "Fan-out"):
+/// raw MAC 03:63:63:6d:00:ID, UDP multicast_base + ID on udp_port.
+PeerAddress GroupAddressFor(const NetworkConfig& net, uint32_t node_id, TransportKind kind);
+/// First four bytes of every group MAC (a locally administered multicast prefix, "ccm").
+constexpr uint8_t kGroupMacPrefix[4] = {0x03, 0x63, 0x63, 0x6d};
 
 /// Address of `peer` for `t`'s kind (broadcast MAC when the peer has none; its
 /// multicast group or unicast IP for UDP). False if the peer cannot be reached.

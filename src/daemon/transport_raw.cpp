@@ -3,12 +3,15 @@
 // kernel. The kernel builds the Ethernet header from the destination MAC.
 #include <arpa/inet.h>
 #include <errno.h>
+#include <linux/filter.h>
 #include <linux/if_packet.h>
 #include <net/ethernet.h>
 #include <net/if.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
+
+#include <vector>
 
 #include "common/platform.h"
 #include "daemon/transport.h"
@@ -55,13 +58,61 @@ ssize_t RawRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
 
 int RawDrops(Transport* t, uint32_t* drops) { return platform::SocketDrops(State(t)->fd, drops); }
 
+// Joins the group MACs (so a NIC with a multicast filter passes them) and attaches a
+// classic BPF filter: a frame to a ccomm group MAC (kGroupMacPrefix) is accepted only for
+// the groups joined; anything else (unicast to us, broadcast) passes as before. Software
+// links (veth, bridges) deliver every multicast frame: without the filter a board would
+// wake for every producer of the system, not only those it exchanges with.
+int RawJoinGroups(Transport* t, const PeerAddress* groups, size_t n, std::string* error) {
+  RawState* st = State(t);
+  for (size_t i = 0; i < n; ++i) {
+    struct packet_mreq mr;
+    memset(&mr, 0, sizeof mr);
+    mr.mr_ifindex = st->ifindex;
+    mr.mr_type = PACKET_MR_MULTICAST;
+    mr.mr_alen = 6;
+    memcpy(mr.mr_address, groups[i].mac, 6);
+    if (setsockopt(st->fd, SOL_PACKET, PACKET_ADD_MEMBERSHIP, &mr, sizeof mr) != 0) {
+      int e = errno;
+      *error = std::string("cannot join multicast MAC group: ") + strerror(e);
+      return -e;
+    }
+  }
+  // Program: A = dest MAC bytes 0-3; not the prefix -> accept; A = bytes 4-5; one
+  // compare per group (at most kMaxNodes, so every jump fits the 8-bit offsets).
+  std::vector<sock_filter> prog;
+  const uint32_t prefix = (uint32_t{kGroupMacPrefix[0]} << 24) | (uint32_t{kGroupMacPrefix[1]} << 16) |
+                          (uint32_t{kGroupMacPrefix[2]} << 8) | kGroupMacPrefix[3];
+  const uint8_t compares = static_cast<uint8_t>(n);
+  prog.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, static_cast<uint32_t>(SKF_LL_OFF)));
+  // Not a group frame: jump over the half-word load, the compares and the drop.
+  prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, prefix, 0, static_cast<uint8_t>(compares + 2)));
+  prog.push_back(BPF_STMT(BPF_LD | BPF_H | BPF_ABS, static_cast<uint32_t>(SKF_LL_OFF + 4)));
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t tail = (uint32_t{groups[i].mac[4]} << 8) | groups[i].mac[5];
+    const uint8_t to_accept = static_cast<uint8_t>(n - i);  // over the remaining compares and the drop
+    prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, tail, to_accept, 0));
+  }
+  prog.push_back(BPF_STMT(BPF_RET | BPF_K, 0));           // another node's group: drop
+  prog.push_back(BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu));  // accept whole frame
+  struct sock_fprog fprog;
+  fprog.len = static_cast<unsigned short>(prog.size());
+  fprog.filter = prog.data();
+  if (setsockopt(st->fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) {
+    int e = errno;
+    *error = std::string("cannot attach the group filter to the raw socket: ") + strerror(e);
+    return -e;
+  }
+  return 0;
+}
+
 void RawClose(Transport* t) {
   RawState* st = State(t);
   if (st->fd >= 0) close(st->fd);
   delete st;
 }
 
-const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawDrops, RawClose};
+const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawDrops, RawJoinGroups, RawClose};
 
 }  // namespace
 

@@ -17,6 +17,8 @@ namespace {
 struct UdpState {
   int fd = -1;
   uint16_t port = 0;  // network order
+  int ifindex = 0;    // interface for group membership (0: by address below, or any)
+  uint32_t self_ipv4 = 0;  // network order, 0 if none
 };
 
 UdpState* State(Transport* t) { return static_cast<UdpState*>(t->state); }
@@ -45,15 +47,52 @@ ssize_t UdpRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
 
 int UdpDrops(Transport* t, uint32_t* drops) { return platform::SocketDrops(State(t)->fd, drops); }
 
+// The IP layer delivers only joined groups to this socket (IP_MULTICAST_ALL is off),
+// so a board never reads frames of producers it does not exchange with.
+int UdpJoinGroups(Transport* t, const PeerAddress* groups, size_t n, std::string* error) {
+  UdpState* st = State(t);
+  for (size_t i = 0; i < n; ++i) {
+    struct ip_mreqn mr;
+    memset(&mr, 0, sizeof mr);
+    mr.imr_multiaddr.s_addr = groups[i].ipv4;
+    mr.imr_ifindex = st->ifindex;
+    if (!st->ifindex) mr.imr_address.s_addr = st->self_ipv4;
+    if (setsockopt(st->fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mr, sizeof mr) != 0) {
+      int e = errno;
+      char a[INET_ADDRSTRLEN] = "?";
+      inet_ntop(AF_INET, &groups[i].ipv4, a, sizeof a);
+      *error = std::string("cannot join multicast group ") + a + ": " + strerror(e) +
+               (e == ENODEV ? " (no multicast route: give the node interface=, or add a route for 224.0.0.0/4)" : "");
+      return -e;
+    }
+  }
+  return 0;
+}
+
 void UdpClose(Transport* t) {
   UdpState* st = State(t);
   if (st->fd >= 0) close(st->fd);
   delete st;
 }
 
-const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpClose};
+const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, UdpClose};
 
 }  // namespace
+
+PeerAddress GroupAddressFor(const NetworkConfig& net, uint32_t node_id, TransportKind kind) {
+  PeerAddress a;
+  if (kind == TransportKind::kRaw) {
+    memcpy(a.mac, kGroupMacPrefix, 4);
+    a.mac[4] = static_cast<uint8_t>(node_id >> 8);
+    a.mac[5] = static_cast<uint8_t>(node_id);
+    return a;
+  }
+  const uint8_t* b = net.multicast_base;
+  const uint32_t host = ((uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3]) + node_id;
+  a.ipv4 = htonl(host);
+  a.port = htons(net.udp_port);
+  return a;
+}
 
 bool PeerAddressFor(const NetworkConfig& net, const NodeConfig& peer, TransportKind kind,
                     PeerAddress* out) {
@@ -84,8 +123,9 @@ int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
   sin.sin_family = AF_INET;
   sin.sin_port = htons(net.udp_port);
   // Unicast: bind to our own address so two nodes may share a host (loopback tests).
-  // Multicast: bind to any and join the group.
-  if (self.multicast.empty() && !self.ip.empty()) inet_pton(AF_INET, self.ip.c_str(), &sin.sin_addr);
+  // Multicast (a node group, or fan-out groups): bind to any and join the group(s).
+  const bool fanout = net.fanout == Fanout::kMulticast;
+  if (self.multicast.empty() && !fanout && !self.ip.empty()) inet_pton(AF_INET, self.ip.c_str(), &sin.sin_addr);
   if (bind(fd, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin) != 0) {
     int e = errno;
     *error = "cannot bind UDP " + (self.ip.empty() ? std::string("*") : self.ip) + ":" +
@@ -109,9 +149,24 @@ int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
     setsockopt(fd, IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop);
     if (mr.imr_ifindex) setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &mr, sizeof mr);
   }
+  UdpState* st = new UdpState;
+  st->ifindex = self.interface.empty() ? 0 : static_cast<int>(if_nametoindex(self.interface.c_str()));
+  if (!self.ip.empty()) inet_pton(AF_INET, self.ip.c_str(), &st->self_ipv4);
+  if (fanout) {
+    // Only groups this socket joined (not every group any socket of the host joined);
+    // looped back so nodes sharing a host hear each other (a node never joins its own).
+    int zero = 0;
+    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_ALL, &zero, sizeof zero);
+    unsigned char loop = 1;
+    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop);
+    struct ip_mreqn mif;
+    memset(&mif, 0, sizeof mif);
+    mif.imr_ifindex = st->ifindex;
+    mif.imr_address.s_addr = st->self_ipv4;  // also the source address peers check
+    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &mif, sizeof mif);
+  }
   struct timeval tv = {recv_timeout_ms / 1000, (recv_timeout_ms % 1000) * 1000};
   setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  UdpState* st = new UdpState;
   st->fd = fd;
   st->port = htons(net.udp_port);
   out->ops = &kUdpOps;

@@ -14,7 +14,7 @@ void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
   wire::FrameHeader h;
   h.flags = flags | auth_.frame_flags();  // kFlagAuth: the writer keeps room for the tag
   h.sender = static_cast<uint16_t>(self_);
-  h.dest = static_cast<uint16_t>(peer);
+  h.dest = p.dest;
   h.config_hash = cfg_->hash;
   h.seq = p.seq;  // advanced only when the frame is really sent
   h.send_time_ns = now;
@@ -40,7 +40,8 @@ void Daemon::FlushPeer(uint32_t peer) {
     return;
   }
   Count(store::kFramesTx);
-  segment_.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
+  // Per-peer counts are for unicast streams; a group frame is counted once, in frames_tx.
+  if (peer != group_tx_) segment_.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
 }
 
 void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
@@ -161,9 +162,8 @@ void Daemon::RunTx() {
       }
       if (due_ns_[id] < next_deadline) next_deadline = due_ns_[id];
     }
-    for (uint32_t p = 0; p < peers_tx_.size(); ++p) {
+    for (uint32_t p : senders_) {
       PeerTx& pt = peers_tx_[p];
-      if (!pt.active) continue;
       if (pt.open) {
         FlushPeer(p);
       } else if (now - pt.last_tx_ns >= heartbeat_ns_) {

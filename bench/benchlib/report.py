@@ -4,7 +4,7 @@ run's rows and meta; the prose only says how to read them."""
 
 import os
 
-from . import results
+from . import per_entry, results
 
 # The thesis' measured min/max one-way latency in µs (section 6.3): rate, min, max.
 THESIS = {
@@ -16,7 +16,10 @@ THESIS = {
             (600, 1100, 2280), (800, 950, 5000)],
 }
 
-TARGETS = {"b2b_raw_ratio": 1.3, "ontarget_ratio": 2.0}
+TARGETS = {"b2b_raw_ratio": 1.3, "ontarget_ratio": 2.0,
+           # Issue 19: 288 B board to board, 36 signals and one 36-element array, each
+           # against the floor carrying the same payload.
+           "b2b_36_signals_ratio": 1.1, "b2b_array_ratio": 1.05}
 
 
 def us(ns):
@@ -121,8 +124,11 @@ def _what(r):
     if n.startswith("ccomm_") and "rtt_half" in n:
         return "ccomm %s, %d double%s, ping/echo through both daemons (RTT/2)" % (
             r["transport"], k, "s" if k > 1 else "")
+    if n.startswith("ccomm_") and (r.get("elements") or 1) > 1:
+        return "ccomm %s, one %d-element double array (one signal), app -> ccommd -> wire -> ccommd -> app" % (
+            r["transport"], r["elements"])
     if n.startswith("ccomm_"):
-        return "ccomm %s, %d double%s, app -> ccommd -> wire -> ccommd -> app" % (
+        return "ccomm %s, %d double%s (separate signals), app -> ccommd -> wire -> ccommd -> app" % (
             r["transport"], k, "s" if k > 1 else "")
     return n
 
@@ -179,6 +185,25 @@ def checks(R, meta):
             ck = _check("board->board %s one-way, %d B: ccomm p50 <= 1.3x the %s floor" % (t, p, t), ok,
                         detail, "b2b")
             ck["rows"] = ("ccomm_%s_oneway_block_1khz_p%d" % (t, p), "net_%s_oneway_1khz_p%d" % (t, p))
+            out.append(ck)
+    # 1b. 288 B as 36 signals and as one 36-element array (per-signal cost, issue 19).
+    for t in ("raw", "udp"):
+        f = R.get("net_%s_oneway_1khz_p288" % t)
+        for cname, key, what in (("ccomm_%s_oneway_block_1khz_p288" % t, "b2b_36_signals_ratio", "36 double signals"),
+                                 ("ccomm_%s_oneway_block_1khz_p288arr" % t, "b2b_array_ratio",
+                                  "one 36-element array")):
+            c = R.get(cname)
+            pairs = _paired_ratios(c, f)
+            pooled = _ratio(c, f)
+            x = _median(pairs) if pairs else pooled
+            target = TARGETS[key]
+            ok = None if x is None else x <= target
+            detail = "n/a (row missing)" if x is None else "p50 %s µs vs floor %s µs = %.2fx%s" % (
+                us(c["p50_ns"]), us(f["p50_ns"]), pooled, "" if not pairs else
+                "; alternation by alternation %s: median **%.2fx**" % (", ".join("%.2f" % r for r in pairs), x))
+            ck = _check("board->board %s one-way, 288 B as %s: ccomm p50 <= %gx the %s floor" % (t, what, target, t),
+                        ok, detail, "b2b")
+            ck["rows"] = (cname, "net_%s_oneway_1khz_p288" % t)
             out.append(ck)
     # 2. below LCM, like with like (both RTT/2 at 1 kHz), and one-way against LCM's RTT/2.
     for cname, lname in (("ccomm_raw_rtt_half_block_1khz_p8", "lcm_netns_rtt_half_1khz_p8"),
@@ -455,6 +480,26 @@ def _cost_tables(R, meta):
                           ["l", "r", "r"]))
         out.append("")
     return "\n".join(out)
+
+
+def _write_per_signal_section(R, meta, sections):
+    """Section 8 (per-signal cost) into its own file, when this run measured any of it."""
+    ratio_rows = []
+    for t in ("raw", "udp"):
+        f = R.get("net_%s_oneway_1khz_p288" % t)
+        for name, label, key in (("ccomm_%s_oneway_block_1khz_p288" % t, "%s, 36 double signals" % t,
+                                  "b2b_36_signals_ratio"),
+                                 ("ccomm_%s_oneway_block_1khz_p288arr" % t, "%s, one 36-element array" % t,
+                                  "b2b_array_ratio")):
+            c = R.get(name)
+            pairs = _paired_ratios(c, f)
+            x = _median(pairs) if pairs else _ratio(c, f)
+            ratio_rows.append(("`%s` (%s)" % (name, label), c, f, pairs, x, TARGETS[key]))
+    text = per_entry.section(R, meta, us, ratio_rows)
+    if text and not meta.get("smoke"):
+        os.makedirs(sections, exist_ok=True)
+        with open(os.path.join(sections, per_entry.SECTION_FILE), "w", encoding="utf-8") as f:
+            f.write(text)
 
 
 def _why(R, meta, check):
@@ -937,7 +982,12 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
     # Sections measured by other suites (system calls, ROS 2 bridge, recorder): each keeps
     # its own file, docs/perf/sections/*.md, and is copied here as it is.
     sections = os.path.join(doc_dir, "perf", "sections")
-    for name in sorted(os.listdir(sections)) if os.path.isdir(sections) else []:
+    _write_per_signal_section(R, meta, sections)
+    def section_order(name):  # "10-x.md" after "9-y.md"
+        number = name.split("-", 1)[0]
+        return (int(number) if number.isdigit() else 1 << 30, name)
+
+    for name in sorted(os.listdir(sections), key=section_order) if os.path.isdir(sections) else []:
         if name.endswith(".md"):
             text = open(os.path.join(sections, name), encoding="utf-8").read()
             L.append("".join(l for l in text.splitlines(True) if not l.startswith("<!--")).rstrip() + "\n")

@@ -119,6 +119,12 @@ def plan(smoke=False, rates=None, scale=1.0):
                                    d,
                                    {"transport": t, "signals": p // 8, "mode": "oneway", "style": "block",
                                     "rate": 1000}))
+                if p == 288:
+                    # The same 288 bytes as one signal (a 36-element array): one entry per
+                    # frame instead of 36, so per-signal and per-byte costs show apart.
+                    cases.append(CCase("ccomm_%s_oneway_block_1khz_p288arr%s" % (t, suffix), "b2b", "ccomm_pair",
+                                       d, {"transport": t, "signals": 1, "count": 36, "mode": "oneway",
+                                           "style": "block", "rate": 1000}))
             if t == "raw" and p == 8:
                 cases.append(CCase("ccomm_raw_oneway_spin_1khz_p8", "b2b", "ccomm_pair", SPIN_SECONDS,
                                    {"transport": "raw", "signals": 1, "mode": "oneway", "style": "spin",
@@ -166,6 +172,7 @@ SMOKE_CASES = {
     "ccomm_shm_state_spin_1khz_p8", "ccomm_shm_state_block_1khz_p8", "ccomm_shm_event_block_1khz_p8",
     "net_raw_oneway_1khz_p8", "net_udp_oneway_1khz_p8", "net_raw_rtt_half_1khz_p8", "lcm_netns_rtt_half_1khz_p8",
     "ccomm_raw_oneway_block_1khz_p8", "ccomm_udp_oneway_block_1khz_p8", "ccomm_raw_oneway_spin_1khz_p8",
+    "ccomm_raw_oneway_block_1khz_p288arr",
     "ccomm_raw_rtt_half_block_1khz_p8",
     "thesis_single_event_1khz", "thesis_setup_event_1khz", "thesis_setup_periodic_1khz",
     "thesis_setup_event_spin_10khz",
@@ -439,9 +446,11 @@ def run_pair(ctx, case):
     ctx.need("ccommd", "ccomm", "ccomm-latency")
     o = case.opts
     k = o["signals"]
+    count = o.get("count", 1)  # > 1: each signal an array of that many doubles
     names = ("client", "server")
-    a2b = ["x%d" % i for i in range(k)]
-    b2a = ["y%d" % i for i in range(k)] if o["mode"] == "ping" else []
+    arr = ":%d" % count if count > 1 else ""
+    a2b = ["x%d%s" % (i, arr) for i in range(k)]
+    b2a = ["y%d%s" % (i, arr) for i in range(k)] if o["mode"] == "ping" else []
     spin = o["style"] == "spin"
     warm = SPIN_WARMUP if spin else 0.5
     rate, dur = o["rate"], case.seconds + warm
@@ -461,15 +470,16 @@ def run_pair(ctx, case):
         res = ccomm.run_apps(d, apps, dur + 30)
         after = _snapshot(d, names)
     dirn = ccomm.delta_stats(before, after, names[0], names[1])
-    extra = dict(style=o["style"], signals=k, signal_kind="state", wire=dirn, sent=res["a"]["sent"],
+    extra = dict(style=o["style"], signals=k, elements=count, signal_kind="state", wire=dirn, sent=res["a"]["sent"],
                  frames_per_cycle=_ratio(dirn["data_frames"], res["a"]["sent"]),
                  command=res["b"]["argv"] if o["mode"] == "oneway" else res["a"]["argv"],
                  daemon_command=d.argv[names[0]])
     if o["mode"] == "ping":
-        row = ccomm.samples_row(case.name, o["transport"], 8 * k, rate, res["a"], sa, ctx.rawdir,
+        row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["a"], sa, ctx.rawdir,
                                 metric="rtt_half", **extra)
     else:
-        row = ccomm.samples_row(case.name, o["transport"], 8 * k, rate, res["b"], sb, ctx.rawdir, **extra)
+        row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["b"], sb, ctx.rawdir,
+                                **extra)
     return [row]
 
 

@@ -101,17 +101,23 @@ size_t CachedBytes(const SignalDirectoryEntry& d) { return (d.flags & st::kSigEv
 // Reads a state through the handle's cache (see StateCache). The change words are read
 // before the copy, so the copy is at least as new as they say; if they move during
 // the copy, the next read copies again.
-StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
+// A value copy: one load and store for the common 8-byte value, not a library call.
+inline void CopyValue(void* dst, const void* src, uint32_t n) {
+  if (n == 8) memcpy(dst, src, 8);
+  else memcpy(dst, src, n);
+}
+
+__attribute__((always_inline)) inline StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
   StateCache& k = h.cache;
   const st::StateStamp stamp = st::StateStampOf(h.state);
   if (stamp.version && stamp == k.stamp) {
-    memcpy(value, k.value, h.value_bytes);
+    CopyValue(value, k.value, h.value_bytes);
     *meta = k.meta;
     return StoreResult::kOk;
   }
   StoreResult r = st::StateRead(h.state, value, meta);
   if (r == StoreResult::kOk) {
-    memcpy(k.value, value, h.value_bytes);
+    CopyValue(k.value, value, h.value_bytes);
     k.meta = *meta;
     k.stamp = stamp;
   }
@@ -302,10 +308,12 @@ int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out
   return 0;
 }
 
-int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_info* info) {
-  HandleSignal* h = Sig(c, s);
-  if (!h || !value) return CCOMM_E_INVAL;
-  if (len != h->value_bytes) return CCOMM_E_TYPE;
+namespace {
+
+// ccomm_read after its argument checks; the typed reads call it directly (no second
+// check, no call through the PLT).
+__attribute__((always_inline)) inline int ReadSignal(ccomm_client* c, HandleSignal* h, void* value,
+                                                     ccomm_info* info) {
   if (Retired(c)) return CCOMM_E_RETIRED;
   SlotMeta meta;
   const uint64_t now = Now(c);
@@ -368,6 +376,15 @@ int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_i
   return status;
 }
 
+}  // namespace
+
+int ccomm_read(ccomm_client* c, ccomm_signal s, void* value, size_t len, ccomm_info* info) {
+  HandleSignal* h = Sig(c, s);
+  if (!h || !value) return CCOMM_E_INVAL;
+  if (len != h->value_bytes) return CCOMM_E_TYPE;
+  return ReadSignal(c, h, value, info);
+}
+
 int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) {
   HandleSignal* h = Sig(c, s);
   if (!h || !value) return CCOMM_E_INVAL;
@@ -424,10 +441,10 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
 
 #define CCOMM_TYPED(suffix, ctype, code)                                                     \
   int ccomm_read_##suffix(ccomm_client* c, ccomm_signal s, ctype* v, ccomm_info* info) {     \
-    const HandleSignal* h = Sig(c, s);                                                       \
+    HandleSignal* h = Sig(c, s);                                                             \
     if (!h || !v) return CCOMM_E_INVAL;                                                      \
     if (h->type != (code) || h->count != 1) return CCOMM_E_TYPE;                             \
-    return ccomm_read(c, s, v, sizeof(ctype), info);                                         \
+    return ReadSignal(c, h, v, info);                                                        \
   }                                                                                          \
   int ccomm_write_##suffix(ccomm_client* c, ccomm_signal s, ctype v) {                       \
     const HandleSignal* h = Sig(c, s);                                                       \

@@ -125,6 +125,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       fwd_cursors_[i].next = store::RingForwardCursor(segment_.ring(static_cast<uint32_t>(i)));
     }
   }
+  PrepareRxTx();
 
   bool any_peer = false;
   for (const PeerTx& pt : peers_tx_) any_peer = any_peer || pt.active;

@@ -91,6 +91,22 @@ class Daemon {
     uint64_t ext = 0;           // its 64-bit extension: the value_seq stored
   };
 
+  // What the receive path needs of a signal, resolved once in Start() (rx_path.cpp): an
+  // entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
+  // one this node consumes, of the right type, count and kind. prefix 0 = not consumed.
+  struct RxSignal {
+    uint64_t prefix = 0;
+    uint32_t producer = UINT32_MAX;
+    bool is_event = false;
+    bool count_gaps = false;    // every value is sent (events, event-driven states)
+    bool one_word = false;      // one 8-byte element (double, int64): converted inline
+    store::StateView state;
+    store::RingView ring;
+    store::SignalStats* stats = nullptr;
+  };
+  void PrepareRxTx();           // fills rx_signals_, rx_known_, tx_prefix_, tx_state_
+  void CountBadEntry(uint16_t signal, const wire::FrameHeader& h);
+
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
   void SettleSteps(uint32_t steps_before);
   void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
@@ -132,6 +148,10 @@ class Daemon {
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
   std::vector<SignalRx> rx_seq_;                  // signal -> last value received (rule 6)
+  std::vector<RxSignal> rx_signals_;              // signal -> receive path's view of it
+  std::vector<uint64_t> rx_known_;                // signal -> wire::DecodeFrame's known entry
+  std::vector<uint64_t> tx_prefix_;               // signal -> its entries' first 8 bytes
+  std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
   std::vector<uint32_t> collected_states_;        // state signals taken this send round
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick

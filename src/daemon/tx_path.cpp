@@ -44,19 +44,27 @@ void Daemon::FlushPeer(uint32_t peer) {
   if (peer != group_tx_) segment_.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
 }
 
-void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
-                      const store::SlotMeta& m, const void* value, uint64_t now) {
+// Inline in CollectSignal: per signal, the common case is one store into an open frame.
+__attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d,
+                                                            uint8_t flags, const store::SlotMeta& m,
+                                                            const void* value, uint64_t now) {
+  (void)flags;  // encoded in tx_prefix_[id] (kEntryEvent for an event signal)
+  const uint64_t prefix = tx_prefix_[id];  // the entry's fixed fields, checked and encoded once (PrepareRxTx)
   for (uint32_t peer : consumers_[id]) {
     PeerTx& p = peers_tx_[peer];
+    if (p.open && p.writer.AddPrepared(prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, value,
+                                       d.value_bytes))
+      continue;
     for (int attempt = 0; attempt < 2; ++attempt) {
-      if (!p.open) BeginFrame(peer, now, 0);
-      if (p.writer.Add(static_cast<uint16_t>(id), d.type, flags, static_cast<uint16_t>(d.count),
-                       static_cast<uint32_t>(m.value_seq), m.source_time_ns, value, d.value_bytes))
+      if (p.open) FlushPeer(peer);  // full: send what we have and start a new frame
+      BeginFrame(peer, now, 0);
+      if (p.writer.AddPrepared(prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, value,
+                               d.value_bytes))
         break;
-      FlushPeer(peer);  // full: send what we have and start a new frame
     }
   }
-  segment_.stats(id).tx.fetch_add(1, std::memory_order_relaxed);
+  std::atomic<uint64_t>& tx = segment_.stats(id).tx;  // this thread is its only writer: no lock
+  tx.store(tx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
 
 void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
@@ -77,7 +85,7 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
     store::SetRingForwardCursor(ring, cur.next);
     return;
   }
-  store::StateView sv = segment_.state(id);
+  const store::StateView& sv = tx_state_[id];  // resolved once (PrepareRxTx)
   uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
   if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
@@ -87,7 +95,9 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   store::MarkStateForwarded(sv, version);
   if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
   uint64_t& last = last_tx_seq_[id];
-  if (!periodic && last && m.value_seq > last + 1)
+  // Values are numbered from 1 in a segment this ccommd created, so values replaced before
+  // the first one sent count too; after re-adoption the predecessor is unknown.
+  if (!periodic && (last || !adopted_) && m.value_seq > last + 1)
     segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
   last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);
@@ -119,6 +129,10 @@ void Daemon::SettleSteps(uint32_t steps_before) {
         if (p.open)
           p.writer.Rewrite(static_cast<uint16_t>(id), static_cast<uint32_t>(m.value_seq), m.source_time_ns, tx_value_);
       }
+      // The value taken first (counted in tx) is replaced in the frame: it and any written
+      // between never leave, so they count as coalesced, as in CollectSignal.
+      if (m.value_seq > last_tx_seq_[id])
+        segment_.stats(id).coalesced.fetch_add(m.value_seq - last_tx_seq_[id], std::memory_order_relaxed);
       last_tx_seq_[id] = m.value_seq;
     }
   }

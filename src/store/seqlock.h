@@ -44,6 +44,12 @@ inline uint64_t CopyCheck(const SlotMeta& meta, const void* value, uint32_t valu
   h = (h ^ meta.source_time_ns) * kOdd;
   h = (h ^ meta.local_time_ns) * kOdd;
   const uint8_t* p = static_cast<const uint8_t*>(value);
+  if (value_bytes == 8) {  // the common value: the loop below, unrolled
+    uint64_t w;
+    memcpy(&w, p, 8);
+    h = (h ^ w) * kOdd;
+    return h ^ (h >> 31);
+  }
   uint32_t i = 0;
   for (; i + 8 <= value_bytes; i += 8) {
     uint64_t w;
@@ -77,20 +83,27 @@ inline bool ClaimCopy(SlotHeader* slot, uint64_t t) {
 
 /// Stamps and publishes a claimed copy (its sequence word is 2t+1): meta, value, then
 /// the sequence word 2t+2 with release order.
-inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* meta4, uint8_t* data, uint64_t t,
-                            uint32_t value_bytes, const void* value, const SlotMeta& meta) {
+/// `check` is CopyCheck(meta, value, value_bytes), computed once by a writer that stores
+/// the same value twice (a state's slot and its inline copy).
+inline void StampCheckedAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* meta4, uint8_t* data,
+                                   uint64_t t, uint32_t value_bytes, const void* value, const SlotMeta& meta,
+                                   uint64_t check) {
   SeqlockWriterFence();
   meta4[0].store(meta.value_seq, kMetaStore);
   meta4[1].store(meta.source_time_ns, kMetaStore);
   meta4[2].store(meta.local_time_ns, kMetaStore);
-  meta4[3].store(CopyCheck(meta, value, value_bytes), kMetaStore);
+  meta4[3].store(check, kMetaStore);
   StoreWords(data, value, value_bytes);
   seq->store(2 * t + 2, std::memory_order_release);
+}
+inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* meta4, uint8_t* data, uint64_t t,
+                            uint32_t value_bytes, const void* value, const SlotMeta& meta) {
+  StampCheckedAndPublish(seq, meta4, data, t, value_bytes, value, meta, CopyCheck(meta, value, value_bytes));
 }
 
 /// Copies a seqlocked value if it holds complete ticket t: kChanged if not (yet) or if
 /// it changed while being copied, kCorrupt if it stayed put but fails its check.
-inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta4, const uint8_t* data,
+__attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta4, const uint8_t* data,
                            uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
   uint64_t s1 = seq->load(std::memory_order_acquire);
   if (s1 != 2 * t + 2) return CopyResult::kChanged;
@@ -108,7 +121,7 @@ inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<u
 inline void PublishSlot(SlotHeader* slot, uint64_t t, uint32_t value_bytes, const void* value, const SlotMeta& meta) {
   StampAndPublish(&slot->seq, &slot->value_seq, reinterpret_cast<uint8_t*>(slot + 1), t, value_bytes, value, meta);
 }
-inline CopyResult ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+__attribute__((always_inline)) inline CopyResult ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
   return ReadCopy(&slot->seq, &slot->value_seq, reinterpret_cast<const uint8_t*>(slot + 1), t, value_bytes, out, meta);
 }
 

@@ -102,14 +102,61 @@ inline StoreResult StateWrite(const StateView& v, const void* value, uint64_t va
   return StoreResult::kBusy;
 }
 
+/// Single-writer store, for a state that one thread of one process writes and nobody
+/// else: a signal received from another node, written only by ccommd's receive thread
+/// (clients may not write it: ccomm_write refuses what is not produced here). Plain
+/// release stores instead of a ticket, claims and CAS; readers see the same copies as
+/// from StateWrite (StateRead is unchanged). Ticket t = `latest`: the writer's own last
+/// publish, so its slot is never the one holding `latest`. Crash safety: a ccommd killed
+/// mid-copy leaves that copy odd (readers skip it, or fall back from the inline copy to
+/// the slot of `latest`); the restarted ccommd adopts the segment and rewrites ticket
+/// `latest` from scratch. A reclaim scan that zeroes a copy being written only makes it
+/// look incomplete until its publish. The check is computed once for both copies.
+/// `latest` is stored with release order; the caller must call PublishedStoresFence()
+/// before it looks at SegmentHeader::rx_waiters (once per frame, not per value).
+__attribute__((always_inline)) inline void StateWriteSingleCopies(const StateView& v, const void* value,
+                                                                  const SlotMeta& meta, uint32_t value_bytes) {
+  StateCell* c = v.cell;
+  const uint64_t t = c->latest.load(std::memory_order_relaxed);
+  const uint64_t check = CopyCheck(meta, value, value_bytes);
+  SlotHeader* h = v.slot(t);
+  h->seq.store(2 * t + 1, std::memory_order_relaxed);
+  StampCheckedAndPublish(&h->seq, &h->value_seq, reinterpret_cast<uint8_t*>(h + 1), t, value_bytes, value, meta,
+                         check);
+  if (value_bytes <= kInlineValueBytes) {
+    c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
+    StampCheckedAndPublish(&c->inline_seq, c->inline_meta, reinterpret_cast<uint8_t*>(c->inline_value), t,
+                           value_bytes, value, meta, check);
+  }
+#ifdef CCOMM_TSAN
+  c->latest.store(t + 1, std::memory_order_seq_cst);  // TSan does not model the fence below
+#else
+  c->latest.store(t + 1, std::memory_order_release);
+#endif
+}
+__attribute__((always_inline)) inline void StateWriteSingle(const StateView& v, const void* value,
+                                                           const SlotMeta& meta) {
+  if (v.value_bytes == 8) StateWriteSingleCopies(v, value, meta, 8);  // constant size: no loops, no branches
+  else StateWriteSingleCopies(v, value, meta, v.value_bytes);
+}
+
+/// Orders every StateWriteSingle before the caller's following load of rx_waiters (the
+/// Dekker pair of SegmentHeader::rx_waiters): one full fence per frame.
+inline void PublishedStoresFence() {
+#ifndef CCOMM_TSAN
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+#endif
+}
+
 /// Copies the newest complete value. Returns kOk, kNever (nothing written yet), kBusy
 /// (writers overtook the reader 16 times in a row) or kCorrupt (see seqlock.h).
-inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
+__attribute__((always_inline)) inline StoreResult StateReadCopies(const StateView& v, void* out, SlotMeta* meta,
+                                                                   uint32_t value_bytes) {
   for (int attempt = 0; attempt < 16; ++attempt) {
     uint64_t latest = v.cell->latest.load(std::memory_order_acquire);
     if (latest == 0) return StoreResult::kNever;
     uint64_t t = latest - 1;
-    if (v.value_bytes <= kInlineValueBytes) {
+    if (value_bytes <= kInlineValueBytes) {
       // The inline copy, if complete and not older than `latest`: it may be newer (its
       // writer has not published yet), never older than anything a later read can
       // fall back to, since its writer publishes before another can refill it.
@@ -117,18 +164,24 @@ inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
       if (!(s1 & 1) && s1 >= 2 * t + 2) {
         uint64_t ti = s1 / 2 - 1;
         const CopyResult r = ReadCopy(&v.cell->inline_seq, v.cell->inline_meta,
-                                      reinterpret_cast<const uint8_t*>(v.cell->inline_value), ti, v.value_bytes, out,
+                                      reinterpret_cast<const uint8_t*>(v.cell->inline_value), ti, value_bytes, out,
                                       meta);
         if (r == CopyResult::kOk) return StoreResult::kOk;
         if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
         continue;  // refilled while we copied
       }
     }
-    const CopyResult r = ReadSlot(v.slot(t), t, v.value_bytes, out, meta);
+    const CopyResult r = ReadSlot(v.slot(t), t, value_bytes, out, meta);
     if (r == CopyResult::kOk) return StoreResult::kOk;
     if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
   }
   return StoreResult::kBusy;
+}
+
+/// The value_bytes == 8 case (one double or int64) compiled with the size known.
+__attribute__((always_inline)) inline StoreResult StateRead(const StateView& v, void* out, SlotMeta* meta) {
+  if (v.value_bytes == 8) return StateReadCopies(v, out, meta, 8);
+  return StateReadCopies(v, out, meta, v.value_bytes);
 }
 
 /// `latest` counter: changes whenever a new value is published (cheap change check).

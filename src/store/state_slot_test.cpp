@@ -58,9 +58,12 @@ TEST(StateSlot, ExplicitSequenceNumbersAreKept) {
   } in = {2.5f};
   ASSERT_EQ(StateWrite(c.view, &in, 777, 1, 2), StoreResult::kOk);
   SlotMeta m;
-  float out = 0;
+  union {  // the same for the read (its 8-byte fast path is inlined too)
+    float f;
+    uint64_t word;
+  } out = {0.0f};
   ASSERT_EQ(StateRead(c.view, &out, &m), StoreResult::kOk);
-  EXPECT_EQ(out, 2.5f);
+  EXPECT_EQ(out.f, 2.5f);
   EXPECT_EQ(m.value_seq, 777u);
 }
 

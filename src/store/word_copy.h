@@ -47,6 +47,12 @@ inline void SeqlockReaderFence() { std::atomic_thread_fence(std::memory_order_ac
 // a variable-size memcpy per word would be a library call per word.
 inline void StoreWords(uint8_t* shm, const void* src, size_t len) {
   const uint8_t* s = static_cast<const uint8_t*>(src);
+  if (len == 8) {  // the common value (one double or int64): no loop
+    uint64_t w;
+    std::memcpy(&w, s, 8);
+    __atomic_store_n(reinterpret_cast<uint64_t*>(shm), w, kDataStoreOrder);
+    return;
+  }
   const size_t full = len & ~size_t{7};
   for (size_t i = 0; i < full; i += 8) {
     uint64_t w;
@@ -62,6 +68,11 @@ inline void StoreWords(uint8_t* shm, const void* src, size_t len) {
 
 inline void LoadWords(void* dst, const uint8_t* shm, size_t len) {
   uint8_t* d = static_cast<uint8_t*>(dst);
+  if (len == 8) {
+    const uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm), kDataLoadOrder);
+    std::memcpy(d, &w, 8);
+    return;
+  }
   const size_t full = len & ~size_t{7};
   for (size_t i = 0; i < full; i += 8) {
     uint64_t w = __atomic_load_n(reinterpret_cast<const uint64_t*>(shm + i), kDataLoadOrder);

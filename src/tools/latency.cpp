@@ -35,7 +35,8 @@ const char kUsage[] =
     "  -r, --rate HZ          send rate (default 1000)\n"
     "  -d, --duration SEC     how long to run (default 10)\n"
     "  -m, --mode MODE        oneway (default), ping, or echo (reply to a ping peer)\n"
-    "      --send A,B,...     signals to write each cycle (default: doubles produced here)\n"
+    "      --send A,B,...     signals to write each cycle (default: doubles and double\n"
+    "                         arrays produced here; an array carries k in every element)\n"
     "      --recv A,B,...     signals to wait for (default: doubles consumed here); event\n"
     "                         signals named here are drained, the newest one counts\n"
     "      --warmup SEC       ignore samples in the first SEC (default 0.5)\n"
@@ -88,6 +89,8 @@ struct Shared {
   ccomm_client* rx_client = nullptr;
   ccomm_client* tx_client = nullptr;
   std::vector<ccomm_signal> send, recv;
+  std::vector<uint32_t> send_count, recv_count;  // elements (double arrays: > 1)
+  std::vector<double> tx_buf, rx_buf;            // one array's elements
   std::vector<uint64_t> send_time;  // [k % kHistory]
   std::atomic<bool> stop{false};
   std::atomic<uint64_t> sent{0};
@@ -99,9 +102,28 @@ struct Shared {
   bool any = false;
 };
 
+// One clock reading per cycle, as a control loop takes it (ccomm_set_time): every value
+// of the cycle is stamped with the cycle's start, so its latency includes the writes.
 void WriteAll(Shared* s, double k) {
-  for (ccomm_signal id : s->send) ccomm_write_double(s->tx_client, id, k);
+  ccomm_set_time(s->tx_client, static_cast<int64_t>(Now()));
+  for (size_t i = 0; i < s->send.size(); ++i) {
+    if (s->send_count[i] == 1) {
+      ccomm_write_double(s->tx_client, s->send[i], k);
+    } else {  // an array: every element carries k
+      std::fill(s->tx_buf.begin(), s->tx_buf.begin() + s->send_count[i], k);
+      ccomm_write(s->tx_client, s->send[i], s->tx_buf.data(), s->send_count[i] * sizeof(double));
+    }
+  }
   ccomm_flush(s->tx_client);
+}
+
+// Reads signal i of --recv: a double, or an array of doubles whose first element is
+// returned (the store hands over whole arrays, so every element is the same k).
+int ReadValue(Shared* s, size_t i, double* v, ccomm_info* info) {
+  if (s->recv_count[i] == 1) return ccomm_read_double(s->rx_client, s->recv[i], v, info);
+  const int r = ccomm_read(s->rx_client, s->recv[i], s->rx_buf.data(), s->recv_count[i] * sizeof(double), info);
+  *v = s->rx_buf[0];
+  return r;
 }
 
 void* Receiver(void* arg) {
@@ -121,7 +143,7 @@ void* Receiver(void* arg) {
     double v;
     ccomm_info info;
     int r;
-    while ((r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info)) == CCOMM_FRESH || r == CCOMM_STALE) {
+    while ((r = ReadValue(s, i, &v, &info)) == CCOMM_FRESH || r == CCOMM_STALE) {
       last_seq[i] = info.seq;
       if (!is_event[i]) break;
     }
@@ -140,14 +162,15 @@ void* Receiver(void* arg) {
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
+    // One clock reading per cycle (ccomm_set_time), as the docs advise control loops:
+    // ages are measured from it, so the store time (t_read - age) is exact for values
+    // stored before it and reads as t_read for one stored during the reads (age 0).
+    const uint64_t t_read = Now();
+    ccomm_set_time(s->rx_client, static_cast<int64_t>(t_read));
     for (size_t i = 0; i < n; ++i) {
       double v;
       ccomm_info info;
-      // ccomm_read takes its clock reading for age_ns on entry: age measured from
-      // just before the call gives the store time even if the call was preempted by
-      // the very ccommd thread that stored the value.
-      const uint64_t t_read = s->stages ? Now() : 0;
-      int r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
+      int r = ReadValue(s, i, &v, &info);
       // Events queue: take every one waiting, keep the newest (one wake-up may find
       // several, and leaving them queued would delay every later sample).
       while ((r == CCOMM_FRESH || r == CCOMM_STALE) && info.seq != last_seq[i]) {
@@ -157,7 +180,7 @@ void* Receiver(void* arg) {
         stored[i] = t_read - static_cast<uint64_t>(info.age_ns);
         changed = true;
         if (!is_event[i]) break;
-        r = ccomm_read_double(s->rx_client, s->recv[i], &v, &info);
+        r = ReadValue(s, i, &v, &info);
       }
     }
     if (!changed || n == 0) continue;
@@ -215,7 +238,7 @@ std::vector<ccomm_signal> Resolve(ccomm_client* c, const std::string& list, bool
   for (int i = 0; i < ccomm_signal_count(c); ++i) {
     ccomm_signal_desc d;
     ccomm_describe(c, i, &d);
-    if (d.type != CCOMM_DOUBLE || d.count != 1 || d.is_event) continue;
+    if (d.type != CCOMM_DOUBLE || d.is_event) continue;
     if (produced ? d.produced_here : d.consumed_here) out.push_back(i);
   }
   return out;
@@ -269,6 +292,21 @@ int main(int argc, char** argv) {
   }
   s.send = Resolve(s.tx_client, o.send, true, "--send");
   s.recv = Resolve(s.rx_client, o.recv, false, "--recv");
+  for (int pass = 0; pass < 2; ++pass) {
+    ccomm_client* c = pass ? s.rx_client : s.tx_client;
+    const std::vector<ccomm_signal>& ids = pass ? s.recv : s.send;
+    std::vector<uint32_t>& counts = pass ? s.recv_count : s.send_count;
+    for (ccomm_signal id : ids) {
+      ccomm_signal_desc d = {};
+      if (ccomm_describe(c, id, &d) != 0 || d.type != CCOMM_DOUBLE) {
+        fprintf(stderr, "ccomm-latency: signal '%s' is not a double or double array\n", d.name ? d.name : "?");
+        return 2;
+      }
+      counts.push_back(d.count);
+      std::vector<double>& buf = pass ? s.rx_buf : s.tx_buf;
+      if (buf.size() < d.count) buf.resize(d.count);
+    }
+  }
   s.ping = o.mode == "ping";
   s.echo = o.mode == "echo";
   s.spin = o.spin;

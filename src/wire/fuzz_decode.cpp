@@ -30,7 +30,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FrameHeader h;
   const DecodeError err = DecodeHeader(data, len, &h);
   Check(DecodeErrorName(err) != nullptr);
+
+  // DecodeFrame with a receiver's table of known entries must give the same verdict.
+  // The table takes the prefixes found at every 8-byte position of the input (those
+  // EntryPrefix accepts), so known entries, near misses and unknown ones all occur.
+  uint64_t known[64] = {};
+  for (size_t off = kHeaderSize; off + 8 <= len; off += 8) {
+    const uint8_t* p = data + off;
+    const uint16_t signal = static_cast<uint16_t>((p[0] << 8) | p[1]);
+    const uint16_t count = static_cast<uint16_t>((p[4] << 8) | p[5]);
+    const uint16_t vlen = static_cast<uint16_t>((p[6] << 8) | p[7]);
+    if (signal < 64) known[signal] = KnownEntryPrefix(EntryPrefix(signal, p[2], p[3], count, vlen), p[2], vlen);
+  }
+  FrameHeader h2;
+  Check(DecodeFrame(data, len, &h2, known, 64) == err);
   if (err != DecodeError::kOk) return 0;
+  Check(h2.seq == h.seq && h2.entry_count == h.entry_count && h2.payload_len == h.payload_len);
 
   const size_t tag = (h.flags & kFlagAuth) ? kAuthTagSize : 0;
   Check(len == kHeaderSize + h.payload_len + tag && len <= kMaxFrameSize);
@@ -55,8 +70,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   EntryIterator it(data, h);
   EntryView e;
   uint16_t n = 0;
+  EntryRef ref = FirstEntry(data);
   while (it.Next(&e)) {
     ++n;
+    Check(ref.prefix() == e.prefix && ref.signal() == e.signal && ref.seq() == e.seq &&
+          ref.value() == e.value && ref.value_len() == e.value_len && ref.source_time_ns() == e.source_time_ns);
+    ref = ref.next();
     Check(e.value >= data && e.value + e.value_len <= data + len);
     Check(e.value_len <= sizeof g_host);
     ValueToHost(e.type, e.value, g_host, e.count);

@@ -64,23 +64,31 @@ inline size_t DeclaredLength(const uint8_t* buf) {
 DecodeError CheckEntry(const uint8_t* p, size_t left, size_t* size) {
   if (left < kEntryHeaderSize) return DecodeError::kBadEntry;
   const uint8_t type = p[kEOffType];
-  const size_t esize = ValueTypeSize(type);
-  if (esize == 0) return DecodeError::kBadEntry;
-  if (p[kEOffFlags] & ~kKnownEntryFlags) return DecodeError::kBadEntry;
+  // Element sizes by type code (ValueTypeSize as a table: this runs once per entry).
+  static constexpr uint8_t kElemSize[8] = {0, 1, 4, 4, 8, 4, 8, 0};
+  static_assert(kElemSize[1] == ValueTypeSize(1) && kElemSize[2] == ValueTypeSize(2) &&
+                    kElemSize[3] == ValueTypeSize(3) && kElemSize[4] == ValueTypeSize(4) &&
+                    kElemSize[5] == ValueTypeSize(5) && kElemSize[6] == ValueTypeSize(6) &&
+                    ValueTypeSize(7) == 0 && ValueTypeSize(0) == 0,
+                "kElemSize is ValueTypeSize");
+  const size_t esize = type < 8 ? kElemSize[type] : 0;
   const size_t count = Load<uint16_t>(p + kEOffCount);
   const size_t value_len = Load<uint16_t>(p + kEOffLen);
-  if (count == 0 || value_len != count * esize) return DecodeError::kBadEntry;
-  if (Load<uint32_t>(p + kEOffReserved) != 0) return DecodeError::kBadEntry;
+  if ((esize == 0) | ((p[kEOffFlags] & ~kKnownEntryFlags) != 0) | (count == 0) | (value_len != count * esize) |
+      (Load<uint32_t>(p + kEOffReserved) != 0))
+    return DecodeError::kBadEntry;
   const size_t total = kEntryHeaderSize + Padded(value_len);
   if (total > left) return DecodeError::kBadEntry;
-  const uint8_t* v = p + kEntryHeaderSize;
-  if (type == kTypeBool) {
-    for (size_t i = 0; i < value_len; ++i) {
-      if (v[i] > 1) return DecodeError::kBadEntry;
+  if (type == kTypeBool || (value_len & 7)) {  // whole 8-byte words of a 4/8-byte type: nothing more to check
+    const uint8_t* v = p + kEntryHeaderSize;
+    if (type == kTypeBool) {
+      for (size_t i = 0; i < value_len; ++i) {
+        if (v[i] > 1) return DecodeError::kBadEntry;
+      }
     }
-  }
-  for (size_t i = value_len; i < Padded(value_len); ++i) {
-    if (v[i] != 0) return DecodeError::kBadEntry;
+    for (size_t i = value_len; i < Padded(value_len); ++i) {
+      if (v[i] != 0) return DecodeError::kBadEntry;
+    }
   }
   *size = total;
   return DecodeError::kOk;
@@ -133,6 +141,7 @@ void FrameWriter::Begin(const FrameHeader& h) {
   if (buf_ == nullptr || cap_ < kHeaderSize || (h.flags & ~kKnownFrameFlags) != 0) return;
   const size_t max = kMaxFrameSize - ((h.flags & kFlagAuth) ? kAuthTagSize : 0);
   limit_ = cap_ < max ? cap_ : max;
+  if (h.flags & kFlagHeartbeat) limit_ = kHeaderSize;  // heartbeats carry no entries: no room for one
   Store<uint32_t>(buf_ + kOffMagic, kMagic);
   buf_[kOffVersion] = kVersion;  // this codec writes v1 only, whatever h.version says
   buf_[kOffFlags] = h.flags;
@@ -177,6 +186,45 @@ bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t cou
   return true;
 }
 
+uint64_t EntryPrefix(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, size_t value_len) {
+  const size_t esize = ValueTypeSize(type);
+  if (esize == 0 || count == 0 || value_len != size_t{count} * esize || (flags & ~kKnownEntryFlags) != 0)
+    return 0;
+  uint8_t b[8];
+  Store<uint16_t>(b + kEOffSignal, signal);
+  b[kEOffType] = type;
+  b[kEOffFlags] = flags;
+  Store<uint16_t>(b + kEOffCount, count);
+  Store<uint16_t>(b + kEOffLen, static_cast<uint16_t>(value_len));
+  uint64_t w;
+  std::memcpy(&w, b, 8);
+  return w;
+}
+
+bool FrameWriter::AddPreparedGeneric(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, const void* value,
+                                     size_t value_len) {
+  if (len_ < kHeaderSize || (buf_[kOffFlags] & kFlagHeartbeat) || prefix == 0 || value == nullptr) return false;
+  if (value_len > limit_ || EntrySize(value_len) > limit_ - len_) return false;
+  uint8_t* p = buf_ + len_;
+  std::memcpy(p, &prefix, 8);
+  Store<uint32_t>(p + kEOffSeq, seq);
+  Store<uint32_t>(p + kEOffReserved, 0);
+  Store<uint64_t>(p + kEOffTime, source_time_ns);
+  uint8_t* v = p + kEntryHeaderSize;
+  const size_t esize = ValueTypeSize(p[kEOffType]);
+  if (esize == 8 && value_len == 8) {  // the common case: one 8-byte value, no padding
+    uint64_t x;
+    std::memcpy(&x, value, 8);
+    Store<uint64_t>(v, x);
+  } else {
+    EncodeValue(v, value, esize, value_len / esize);
+    std::memset(v + value_len, 0, Padded(value_len) - value_len);
+  }
+  len_ += EntrySize(value_len);
+  ++count_;
+  return true;
+}
+
 bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value) {
   if (len_ < kHeaderSize) return false;
   size_t off = kHeaderSize;
@@ -212,7 +260,9 @@ size_t FrameWriter::Finish() {
   return len_;
 }
 
-DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
+DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) { return DecodeFrame(buf, len, h, nullptr, 0); }
+
+DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const uint64_t* known, size_t known_count) {
   if (buf == nullptr || len < kHeaderSize) return DecodeError::kTooShort;
   if (Load<uint32_t>(buf + kOffMagic) != kMagic) return DecodeError::kBadMagic;
   if (buf[kOffVersion] != kVersion) return DecodeError::kBadVersion;
@@ -244,6 +294,21 @@ DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
   }
   for (uint16_t i = 0; i < entry_count; ++i) {
     size_t size = 0;
+    if (left >= kEntryHeaderSize) {
+      // A known entry: its first 8 bytes are ones CheckEntry accepts (EntryPrefix) with
+      // whole-word values, so only the reserved word and the bounds are left to check.
+      const uint16_t signal = Load<uint16_t>(p + kEOffSignal);
+      uint64_t prefix;
+      std::memcpy(&prefix, p, 8);
+      if (signal < known_count && known[signal] == prefix && prefix != 0 && Load<uint32_t>(p + kEOffReserved) == 0) {
+        size = kEntryHeaderSize + Load<uint16_t>(p + kEOffLen);
+        if (size <= left) {
+          p += size;
+          left -= size;
+          continue;
+        }
+      }
+    }
     const DecodeError e = CheckEntry(p, left, &size);
     if (e != DecodeError::kOk) return e;
     p += size;
@@ -271,21 +336,6 @@ size_t TrimEthernetPadding(const uint8_t* buf, size_t len) {
     if (buf[i] != 0) return len;  // not padding: let DecodeHeader report trailing bytes
   }
   return total;
-}
-
-bool EntryIterator::Next(EntryView* e) {
-  if (left_ == 0) return false;
-  e->signal = Load<uint16_t>(p_ + kEOffSignal);
-  e->type = p_[kEOffType];
-  e->flags = p_[kEOffFlags];
-  e->count = Load<uint16_t>(p_ + kEOffCount);
-  e->value_len = Load<uint16_t>(p_ + kEOffLen);
-  e->seq = Load<uint32_t>(p_ + kEOffSeq);
-  e->source_time_ns = Load<uint64_t>(p_ + kEOffTime);
-  e->value = p_ + kEntryHeaderSize;
-  p_ += FrameWriter::EntrySize(e->value_len);
-  --left_;
-  return true;
 }
 
 void ValueToHost(uint8_t type, const uint8_t* src, void* dst, size_t count) {

@@ -118,6 +118,17 @@ def test_never_received(client: Client) -> None:
     assert r.status == Status.NEVER and r.value == 0.0 and r.seq == 0 and r.age_ns is None
 
 
+def test_history_of_received_states_only(client: Client) -> None:
+    # node "pytest" has history="64": the state it receives keeps a history ring (nothing
+    # arrives: "remote" never runs), signals it produces and events have none.
+    h = client["remote_x"].history()
+    assert h.depth == 64 and h.read() is None and list(h.drain()) == [] and h.overrun == 0
+    with pytest.raises(ccomm.NotFoundError):
+        client["d"].history()
+    with pytest.raises(ccomm.NotFoundError):
+        client["ev"].history()
+
+
 def test_events_are_queued(client: Client, node: str) -> None:
     with Client(node) as reader:
         ev = reader.signal("ev")

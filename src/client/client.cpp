@@ -10,6 +10,7 @@
 
 #include <new>
 
+#include "client/client_internal.h"
 #include "client/doorbell.h"
 #include "common/platform.h"
 #include "common/value_type.h"
@@ -167,6 +168,8 @@ void FillNever(ccomm_info* info) {
 }
 
 }  // namespace
+
+const Segment& ccomm::client::SegmentOf(const ccomm_client* c) { return c->segment; }
 
 extern "C" {
 

@@ -53,6 +53,8 @@ struct NodeConfig {
                                      // produced elsewhere (expanded into the consumer lists)
   TransportKind transport = TransportKind::kRaw;
   RealtimeConfig realtime;
+  uint32_t history = 0;        // history="N": received states keep their last N values (power of
+                               // two; 0 = none). Local policy, not in the config hash.
   int line = 0;                // line of <node> in the file, for messages
 };
 

@@ -391,7 +391,7 @@ TEST(Hash, IgnoresLayoutCommentsAndLocalPolicy) {
             base);
   EXPECT_EQ(HashOf(Replace(b, "<node name=\"server\" interface=\"eth0\"/>",
                            "<node name=\"server\" interface=\"eth1\" ip=\"10.0.0.2\" "
-                           "mac=\"02:00:00:00:00:02\"><realtime priority=\"90\"/></node>")),
+                           "mac=\"02:00:00:00:00:02\" history=\"1024\"><realtime priority=\"90\"/></node>")),
             base);
   EXPECT_EQ(HashOf(Replace(b, "<network ethertype=\"0x88B5\" udp_port=\"47800\"/>",
                            "<network ethertype=\"34997\" udp_port=\"47800\" heartbeat_ms=\"10\" "
@@ -569,6 +569,11 @@ TEST(Parse, NetworkAndNodeEdgeCases) {
       {R"(<node name="a" interface="eth0" multicast="239.255.255.255"/>)", nullptr},
       {R"(<node name="a" interface="eth0" multicast="240.0.0.1"/>)", "not in 224.0.0.0/4"},
       {R"(<node name="a" interface="eth0" multicast="223.255.255.255"/>)", "not in 224.0.0.0/4"},
+      {R"(<node name="a" interface="eth0" history="256"/>)", nullptr},
+      {R"(<node name="a" interface="eth0" history="65536"/>)", nullptr},
+      {R"(<node name="a" interface="eth0" history="100"/>)", "history 100 is not a power of two"},
+      {R"(<node name="a" interface="eth0" history="1"/>)", "out of range"},
+      {R"(<node name="a" interface="eth0" history="131072"/>)", "out of range"},
       {R"(<node name="a" interface="a-very-long-name0"/>)", "invalid interface name"},
       {R"(<node name="a" interface="eth0:1"/>)", "invalid interface name"},
       {R"(<node name="a"/>)", "raw node 'a' needs interface="},

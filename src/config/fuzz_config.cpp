@@ -27,6 +27,7 @@ void CheckAccepted(const SystemConfig& c) {
     Check(!n.name.empty() && n.name.size() <= kMaxNameLength);
     Check(c.FindNode(n.name) == static_cast<int>(i));  // names are unique
     Check(n.realtime.priority >= 0 && n.realtime.priority <= 99);
+    Check(n.history == 0 || (n.history >= 2 && n.history <= 65536 && (n.history & (n.history - 1)) == 0));
   }
   for (size_t i = 0; i < c.signals.size(); ++i) {
     const SignalConfig& s = c.signals[i];

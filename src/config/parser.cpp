@@ -253,7 +253,7 @@ void Parser::Network(const Node* n, NetworkConfig* net) {
 }
 
 void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
-  Element e(n, {"name", "interface", "mac", "ip", "multicast", "transport", "monitor"}, &diag_);
+  Element e(n, {"name", "interface", "mac", "ip", "multicast", "transport", "monitor", "history"}, &diag_);
   node->line = e.line();
   Name(e, "node", &node->name);
   CheckNoText(n, &diag_);
@@ -272,6 +272,11 @@ void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
       Realtime(c, &node->realtime);
     }
   }
+
+  if (e.Has("history") && Unsigned(e, "history", 2, 65536, &node->history) &&
+      (node->history & (node->history - 1)))
+    Err(e.Get("history")->line, "history " + std::to_string(node->history) +
+                                    " is not a power of two (e.g. 256, 1024)");
 
   bool transport_ok = true;
   if (const AttrValue* a = e.Get("transport")) {

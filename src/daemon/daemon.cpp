@@ -112,6 +112,8 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   int r = CreateOrAdoptSegment(&segment_, cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
+  history_.assign(n, store::RingView());
+  for (uint32_t i = 0; i < n; ++i) history_[i] = segment_.history(i);
   for (uint32_t p = 0; p < m; ++p) segment_.peer(p).alive.store(0);  // a re-adopted segment's are stale
   if (adopted_) {
     // Writers that died while this ccommd was down may have left slots half-written.

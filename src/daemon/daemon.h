@@ -91,8 +91,8 @@ class Daemon {
     uint64_t ext = 0;           // its 64-bit extension: the value_seq stored
   };
 
-  // What the receive path needs of a signal, resolved once in Start() (rx_path.cpp): an
-  // entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
+  // What the receive path needs of a signal, resolved once in Start() (prepared_signals.cpp):
+  // an entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
   // one this node consumes, of the right type, count and kind. prefix 0 = not consumed.
   struct RxSignal {
     uint64_t prefix = 0;
@@ -121,6 +121,10 @@ class Daemon {
   uint64_t AcceptValue(uint32_t id, uint32_t seq, bool count_gaps);
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
+  /// History tap (<node history="N">): appends a stored state value to its ring, if any.
+  void AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
+    if (history_[id].ring) store::RingWrite(history_[id], value, seq, source_ns, now);
+  }
   void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
     segment_.header()->daemon_counters[c].fetch_add(1, order);
   }
@@ -152,6 +156,7 @@ class Daemon {
   std::vector<uint64_t> rx_known_;                // signal -> wire::DecodeFrame's known entry
   std::vector<uint64_t> tx_prefix_;               // signal -> its entries' first 8 bytes
   std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
+  std::vector<store::RingView> history_;          // signal -> history ring (ring null: none)
   std::vector<uint32_t> collected_states_;        // state signals taken this send round
   std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick

@@ -143,7 +143,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
   if (h.flags & wire::kFlagHeartbeat) ps.heartbeats_rx.fetch_add(1, std::memory_order_relaxed);
 
-  // One compare per entry tells a good one (RxSignal::prefix); DecodeHeader has already
+  // One compare per entry tells a good one (RxSignal::prefix); DecodeFrame has already
   // checked every entry's structure, so nothing is validated twice. States go through the
   // single-writer store (ccommd is the only writer of a received signal), counters through
   // plain stores (this thread is their only writer): a small constant per entry.
@@ -184,6 +184,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
       }
     } else {
       store::StateWriteSingle(rs->state, value, store::SlotMeta{value_seq, e.source_time_ns(), now});
+      AppendHistory(id, value, value_seq, e.source_time_ns(), now);
     }
     rs->stats->rx.store(rs->stats->rx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     rs->stats->last_rx_ns.store(now, std::memory_order_relaxed);

@@ -23,14 +23,24 @@ size_t SlotBytes(const SignalConfig& s) {
   return AlignUp(sizeof(SlotHeader) + AlignUp(s.value_bytes(), 8), kCacheLine);
 }
 
-size_t DataBytes(const SignalConfig& s) {
+// Values of `s` node `node_id` keeps in a history ring (layout.h): states it receives,
+// when the node asks for history; 0 otherwise.
+uint32_t HistoryDepth(const SystemConfig& cfg, const SignalConfig& s, uint32_t node_id) {
+  if (s.kind != SignalKind::kState || s.producer == node_id) return 0;
+  bool consumed_here = false;
+  for (uint32_t c : s.consumers) consumed_here |= c == node_id;
+  return consumed_here ? cfg.nodes[node_id].history : 0;
+}
+
+size_t DataBytes(const SignalConfig& s, uint32_t history_depth) {
   size_t slots = s.kind == SignalKind::kEvent ? s.queue_depth : kStateSlots;
   size_t head = s.kind == SignalKind::kEvent ? sizeof(EventRing) : sizeof(StateCell);
   size_t safe = s.has_safe_value ? AlignUp(s.value_bytes(), 8) : 0;
-  return AlignUp(head + slots * SlotBytes(s) + safe, kCacheLine);
+  size_t history = history_depth ? sizeof(EventRing) + history_depth * SlotBytes(s) : 0;
+  return AlignUp(head + slots * SlotBytes(s) + safe, kCacheLine) + history;
 }
 
-Plan MakePlan(const SystemConfig& cfg) {
+Plan MakePlan(const SystemConfig& cfg, uint32_t node_id) {
   Plan p;
   size_t n = cfg.signals.size(), m = cfg.nodes.size();
   p.directory = AlignUp(sizeof(SegmentHeader), kCacheLine);
@@ -40,17 +50,17 @@ Plan MakePlan(const SystemConfig& cfg) {
   p.dirty = AlignUp(p.peer_stats + m * sizeof(PeerStats), kCacheLine);
   p.data = AlignUp(p.dirty + ((n + 63) / 64) * 8, kCacheLine);
   size_t off = p.data;
-  for (const auto& s : cfg.signals) off += DataBytes(s);
+  for (const auto& s : cfg.signals) off += DataBytes(s, HistoryDepth(cfg, s, node_id));
   p.total = AlignUp(off, 4096);
   return p;
 }
 
 }  // namespace
 
-size_t SegmentSize(const SystemConfig& cfg) { return MakePlan(cfg).total; }
+size_t SegmentSize(const SystemConfig& cfg, uint32_t node_id) { return MakePlan(cfg, node_id).total; }
 
 void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size) {
-  Plan p = MakePlan(cfg);
+  Plan p = MakePlan(cfg, node_id);
   memset(mem, 0, size);
   auto* h = new (mem) SegmentHeader();
   h->magic = kSegmentMagic;
@@ -105,14 +115,19 @@ void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t s
       d.safe_value_offset = off + head + slots * d.slot_bytes;
       memcpy(At<uint8_t>(mem, d.safe_value_offset), s.safe_value.data(), s.value_bytes());
     }
-    off += DataBytes(s);
+    const uint32_t history = HistoryDepth(cfg, s, node_id);
+    if (history) {
+      d.history_depth = history;
+      d.history_offset = off + DataBytes(s, 0);  // after the cell, its slots and safe value
+    }
+    off += DataBytes(s, history);
   }
   h->state.store(kInitializing, std::memory_order_relaxed);
 }
 
 int CreateOrAdoptSegment(store::Segment* segment, const SystemConfig& cfg, uint32_t node_id,
                          const std::string& name, int gid, bool* adopted, std::string* error) {
-  const size_t size = SegmentSize(cfg);
+  const size_t size = SegmentSize(cfg, node_id);
   std::vector<uint8_t> image(size);
   BuildSegment(cfg, node_id, image.data(), size);
   return segment->CreateOrAdopt(image.data(), size, name, gid, adopted, error);

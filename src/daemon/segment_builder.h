@@ -12,8 +12,8 @@
 
 namespace ccomm {
 
-/// Bytes of the segment `cfg` gives every node (whole pages).
-size_t SegmentSize(const SystemConfig& cfg);
+/// Bytes of the segment `cfg` gives node `node_id` (whole pages).
+size_t SegmentSize(const SystemConfig& cfg, uint32_t node_id);
 /// Builds the complete segment image for `cfg` as seen by `node_id` into `mem` (size
 /// from SegmentSize). Used for creation and to compare with an existing segment.
 void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size);

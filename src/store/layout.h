@@ -25,7 +25,7 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 4;
+constexpr uint32_t kLayoutVersion = 5;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
@@ -107,6 +107,12 @@ struct alignas(8) SignalDirectoryEntry {
   uint32_t queue_depth;    // events: ring capacity (power of two); states: kStateSlots
   uint64_t data_offset;    // StateCell or EventRing
   uint64_t safe_value_offset;  // value_bytes, rounded to 8; 0 if none
+  // History tap (<node history="N">): states received from another node also keep their
+  // last N values, in order, in an EventRing (ccommd appends each value it stores), so a
+  // recorder sees every value however late it reads. 0 / 0 when the node keeps none.
+  uint64_t history_offset;     // EventRing + history_depth slots of slot_bytes
+  uint32_t history_depth;      // power of two
+  uint32_t reserved2;
 };
 
 // Header of every slot (state copy or event), followed by the value rounded up to 8 bytes.

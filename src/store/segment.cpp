@@ -42,6 +42,19 @@ RingView Segment::ring(uint32_t id) const {
   return v;
 }
 
+RingView Segment::history(uint32_t id) const {
+  const SignalDirectoryEntry& d = dir(id);
+  RingView v;
+  if (!d.history_offset) return v;
+  v.ring = At<EventRing>(base_, d.history_offset);
+  v.slots = At<uint8_t>(base_, d.history_offset + sizeof(EventRing));
+  v.slot_bytes = d.slot_bytes;
+  v.value_bytes = d.value_bytes;
+  v.depth = d.history_depth;
+  v.backpressure = false;  // the oldest value is overwritten; a lagging reader counts its overrun
+  return v;
+}
+
 const uint8_t* Segment::safe_value(uint32_t id) const {
   const SignalDirectoryEntry& d = dir(id);
   return d.safe_value_offset ? At<uint8_t>(base_, d.safe_value_offset) : nullptr;
@@ -176,6 +189,12 @@ std::string CheckLayout(const void* base, size_t size) {
       return "signal " + std::to_string(i) + ": data outside the segment";
     if (d.safe_value_offset && !within(d.safe_value_offset, d.value_bytes))
       return "signal " + std::to_string(i) + ": safe value outside the segment";
+    if (d.history_offset || d.history_depth) {
+      const uint64_t hd = d.history_depth;
+      if (event || hd < 2 || (hd & (hd - 1)) || d.history_offset % kCacheLine ||
+          !within(d.history_offset, sizeof(EventRing) + hd * d.slot_bytes))
+        return "signal " + std::to_string(i) + ": bad history ring";
+    }
   }
   return "";
 }

@@ -54,6 +54,8 @@ class Segment {
   std::atomic<uint64_t>* dirty_words() const { return At<std::atomic<uint64_t>>(base_, layout_.dirty_offset); }
   StateView state(uint32_t id) const;
   RingView ring(uint32_t id) const;
+  /// The history ring of a received state signal (layout.h); ring == nullptr if none.
+  RingView history(uint32_t id) const;
   const uint8_t* safe_value(uint32_t id) const;
   /// Signal id by name, or -1 (linear scan: start-up only).
   int Find(const char* name) const;

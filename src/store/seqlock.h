@@ -103,8 +103,9 @@ inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* m
 
 /// Copies a seqlocked value if it holds complete ticket t: kChanged if not (yet) or if
 /// it changed while being copied, kCorrupt if it stayed put but fails its check.
-__attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq, const std::atomic<uint64_t>* meta4, const uint8_t* data,
-                           uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+__attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq,
+                                                         const std::atomic<uint64_t>* meta4, const uint8_t* data,
+                                                         uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
   uint64_t s1 = seq->load(std::memory_order_acquire);
   if (s1 != 2 * t + 2) return CopyResult::kChanged;
   meta->value_seq = meta4[0].load(kMetaLoad);
@@ -121,7 +122,8 @@ __attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint
 inline void PublishSlot(SlotHeader* slot, uint64_t t, uint32_t value_bytes, const void* value, const SlotMeta& meta) {
   StampAndPublish(&slot->seq, &slot->value_seq, reinterpret_cast<uint8_t*>(slot + 1), t, value_bytes, value, meta);
 }
-__attribute__((always_inline)) inline CopyResult ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+__attribute__((always_inline)) inline CopyResult ReadSlot(const SlotHeader* slot, uint64_t t, uint32_t value_bytes,
+                                                         void* out, SlotMeta* meta) {
   return ReadCopy(&slot->seq, &slot->value_seq, reinterpret_cast<const uint8_t*>(slot + 1), t, value_bytes, out, meta);
 }
 

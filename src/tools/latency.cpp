@@ -330,7 +330,7 @@ int main(int argc, char** argv) {
   }
   const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
   const uint64_t end = start + static_cast<uint64_t>(o.duration * 1e9);
-  uint64_t next = start;
+  uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
   for (uint64_t k = 1;; ++k) {
     next += period;
     struct timespec ts = {static_cast<time_t>(next / 1000000000ull), static_cast<long>(next % 1000000000ull)};

@@ -260,7 +260,9 @@ size_t FrameWriter::Finish() {
   return len_;
 }
 
-DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) { return DecodeFrame(buf, len, h, nullptr, 0); }
+DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
+  return DecodeFrame(buf, len, h, nullptr, 0);
+}
 
 DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const uint64_t* known, size_t known_count) {
   if (buf == nullptr || len < kHeaderSize) return DecodeError::kTooShort;

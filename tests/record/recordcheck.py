@@ -1,19 +1,25 @@
 # SPDX-License-Identifier: Apache-2.0
 """Checks of the record suite (tests/record/run), run in its venv. Reads recordings with
 the `mcap` package's own reader only (not ccomm's code), so a wrong writer cannot hide.
-`written` and `same` exit 0 when exact, 1 when a value is wrong, duplicated, out of order
-or missing without a gap field saying so, 3 when values are only missing (each accounted
-for) or late: what an overloaded host causes (a state value replaced before anyone read it).
+`written` and `same` exit 0 when exact; 1 when a value is wrong, duplicated, out of order,
+missing without a gap field saying so, stored by the monitor's ccommd but not in the file,
+or lost without a ccommd counter; 3 when values are missing that never reached the monitor,
+each counted by a ccommd (the producer's `coalesced`: replaced before it was sent, issue
+16's producer side; the monitor's `lost`: frames lost or dropped at its socket); `same` 4
+when the timing is outside the tolerance.
 
   recordcheck.py config SRC.xml OUT.xml            three-node config: SRC's two nodes + monitor
-  recordcheck.py written FILE.mcap CONFIG NODE=SENT.json...  every value ccomm-latency wrote is in FILE
-  recordcheck.py same ORIG.mcap REPLAYED.mcap MS   same values in the same order, timing within MS
+  recordcheck.py written FILE.mcap CONFIG NODE=SENT.json... -- NODE=STATS.json...
+                                                   every value ccomm-latency wrote is in FILE
+  recordcheck.py same ORIG.mcap REPLAYED.mcap MS CONFIG NODE=STATS.json...
+                                                   same values in the same order, timing within MS
   recordcheck.py throughput STATS.json RATE        the recorder missed nothing at >= RATE values/s
   recordcheck.py forge OUT.mcap other|changed|foreign   a recording replay must refuse
   recordcheck.py corrupt IN.mcap OUT.mcap         IN with bytes of its first chunk overwritten
   recordcheck.py fuzz N WORKDIR                    N mutated recordings: loaded or refused, no crash
   recordcheck.py floor N WORKDIR                   CPU ns per message of the mcap library alone
   recordcheck.py count FILE.mcap                   number of messages (mcap's own reader)
+  recordcheck.py daemons STATS.json...             where values went missing, by ccommd (`ccomm stats --json`)
 """
 import json
 import re
@@ -24,14 +30,15 @@ from mcap.reader import make_reader
 
 
 def make_config(src: str, out: str) -> None:
-    """The demo's setup-simulation with a third node 'monitor' that consumes every signal,
+    """The demo's setup-simulation with a third node 'monitor' that consumes every signal
+    and keeps the last 4096 values of each (its history tap: the recorder gets every one),
     all on loopback UDP (127.0.0.1-3 inside the suite's own network namespace)."""
     x = open(src).read()
     x = x.replace('ip="10.42.0.1"', 'ip="127.0.0.1"').replace('ip="10.42.0.2"', 'ip="127.0.0.2"')
     x = x.replace('interface="eth0"', 'interface="lo"')
     x = x.replace('consumers="planner"', 'consumers="planner,monitor"')
     x = x.replace('consumers="control"', 'consumers="control,monitor"')
-    monitor = ('  <node name="monitor" interface="lo" ip="127.0.0.3" transport="udp">\n'
+    monitor = ('  <node name="monitor" interface="lo" ip="127.0.0.3" transport="udp" history="4096">\n'
                '    <realtime mlockall="true" priority="80"/>\n  </node>\n')
     x = re.sub(r"(\n  <!--[^\n]*\n  <signal )", "\n" + monitor + r"\1", x, count=1)
     if "monitor" not in x.split("<signal", 1)[0]:
@@ -55,12 +62,45 @@ def produced_by(config: str, node: str) -> list:
     return re.findall(r'<signal name="([^"]+)" type="double" producer="%s"' % node, open(config).read())
 
 
-def check_written(path: str, config: str, sent_files: list) -> int:
+def load_stats(args: list) -> dict:
+    """{node: {signal: counters}} from NODE=STATS.json arguments (`ccomm stats --json`)."""
+    out = {}
+    for arg in args:
+        node, path = arg.split("=", 1)
+        out[node] = {x["name"]: x for x in json.load(open(path))["signals"]}
+    return out
+
+
+def account(name: str, got: int, expected: int, stored: dict, producer: dict, tally: list) -> str:
+    """Why values of `name` are missing from a recording: '' when every one is counted by
+    a ccommd, else what does not add up. The recorder must hold every value the monitor's
+    ccommd stored (its `rx`). Each value that never reached the monitor must be counted
+    there as a gap in the sequence (`lost`: frames lost or dropped at its socket, values
+    the producer replaced unsent), except values the producer replaced before the first
+    one the monitor got (no gap to see), which the producer counts (`coalesced`).
+    tally += [coalesced at the producer, lost on the way] (the missing values' causes)."""
+    rx = stored[name]["rx"]
+    if got != rx:
+        return f"{name}: the file holds {got} values, the monitor's ccommd stored {rx}: the recorder lost values"
+    missing, gaps, coalesced = expected - rx, stored[name]["lost"], producer[name]["coalesced"]
+    if not gaps <= missing <= gaps + coalesced:
+        return (f"{name}: {missing} values never reached the monitor; its ccommd counted {gaps} gaps, "
+                f"the producer's {coalesced} coalesced: values lost without being counted")
+    tally[0] += min(missing, coalesced)
+    tally[1] += missing - min(missing, coalesced)
+    return ""
+
+
+def check_written(path: str, config: str, sent_files: list, stats: dict) -> int:
     """ccomm-latency writes its cycle number k = 1, 2, ... to every double its node
     produces, so on fresh daemons value == seq == k for k = 1..sent. sent_files: NODE=JSON
-    (ccomm-latency's output)."""
+    (ccomm-latency's output). stats: load_stats() of the monitor and the producers.
+    0: every value in the file; 3: values missing that never reached the monitor, each one
+    counted by a ccommd (see account), and the file = what the monitor stored; 1: anything else (a wrong, duplicated or unordered value, a value the monitor stored
+    that the file lacks, a value lost without a counter)."""
     got = read_values(path)
     wrong = missing = total = nsig = 0
+    tally = [0, 0]
     for arg in sent_files:
         node, sf = arg.split("=", 1)
         sent, names = json.load(open(sf))["sent"], produced_by(config, node)
@@ -73,33 +113,36 @@ def check_written(path: str, config: str, sent_files: list) -> int:
             unordered = sum(1 for a, b in zip(seqs, seqs[1:]) if b <= a)
             unaccounted = sum(1 for a, b in zip(vals, vals[1:]) if b[0] - a[0] - 1 != b[4])
             miss = sent - len(vals)
-            if bad or unordered or unaccounted:
+            why = account(name, len(vals), sent, stats["monitor"], stats[node], tally)
+            if bad or unordered or unaccounted or why:
                 wrong += 1
                 print(f"# {name}: WRONG: {len(bad)} values != seq or out of 1..{sent} (e.g. {bad[:2]}), "
-                      f"{unordered} out of order, {unaccounted} gaps not in the gap field")
+                      f"{unordered} out of order, {unaccounted} gaps not in the gap field. {why}")
             elif miss:
                 gone = sorted(set(range(1, sent + 1)) - set(seqs))
                 print(f"# {name}: {len(vals)} of {sent} values; missing seq {gone[:8]}"
-                      f"{' ...' if len(gone) > 8 else ''} (each one in a gap field or before the first)")
+                      f"{' ...' if len(gone) > 8 else ''}: never reached the monitor (counted by ccommd)")
             missing += miss
-    print(f"# recording: {total} values of {nsig} signals, {missing} missing, {wrong} signals wrong")
+    print(f"# recording: {total} values of {nsig} signals, {wrong} signals wrong, {missing} values missing: "
+          f"{tally[0]} coalesced at the producer, {tally[1]} lost on the way (frames lost, socket drops)")
     if wrong:
         return 1
     return 3 if missing else 0
 
 
-def check_same(orig: str, replayed: str, tol_ms: float) -> int:
+def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str) -> int:
     """On fresh daemons the replaying node numbers its writes 1, 2, ...: the replayed
-    value with seq k must equal the k-th recorded value, and its time offset from the first
-    write must be within tol_ms of the recorded one."""
+    value with seq k must equal the k-th recorded value, and its time offset from the
+    signal's first replayed value must be within tol_ms of the recorded one (each board
+    replays in its own process, started at its own moment). Exit codes as check_written."""
     a, b = read_values(orig), read_values(replayed)
     if sorted(a) != sorted(b):
         print(f"# signals differ: only in original {sorted(set(a) - set(b))[:5]}, "
               f"only in replay {sorted(set(b) - set(a))[:5]}")
         return 1
-    t0a = min(v[0][2] for v in a.values() if v)
-    t0b = min(v[0][2] for v in b.values() if v)
+    producer = {n: node for node in ("control", "planner") for n in produced_by(config, node)}
     wrong = missing = n = 0
+    tally = [0, 0]
     errs = []
     for name in sorted(a):
         va, vb = a[name], b[name]
@@ -107,15 +150,19 @@ def check_same(orig: str, replayed: str, tol_ms: float) -> int:
         bad = [v for v in vb if not 1 <= v[0] <= len(va) or v[1] != va[v[0] - 1][1]]
         unordered = sum(1 for x, y in zip(seqs, seqs[1:]) if y <= x)
         unaccounted = sum(1 for x, y in zip(vb, vb[1:]) if y[0] - x[0] - 1 != y[4])
-        if bad or unordered or unaccounted:
+        why = account(name, len(vb), len(va), stats["monitor"], stats[producer[name]], tally)
+        if bad or unordered or unaccounted or why:
             wrong += 1
             print(f"# {name}: WRONG: {len(bad)} replayed values differ from the recorded ones "
-                  f"(e.g. {bad[:2]}), {unordered} out of order, {unaccounted} gaps not in the gap field")
+                  f"(e.g. {bad[:2]}), {unordered} out of order, {unaccounted} gaps not in the gap field. {why}")
             continue
         if len(vb) != len(va):
-            print(f"# {name}: {len(vb)} of {len(va)} replayed values in the second recording; "
-                  f"missing {sorted(set(range(1, len(va) + 1)) - set(seqs))[:8]}")
+            print(f"# {name}: {len(vb)} of {len(va)} replayed values in the second recording; missing "
+                  f"{sorted(set(range(1, len(va) + 1)) - set(seqs))[:8]}: never reached the monitor (counted by ccommd)")
         missing += len(va) - len(vb)
+        if not vb:
+            continue
+        t0a, t0b = va[vb[0][0] - 1][2], vb[0][2]
         for y in vb:
             x = va[y[0] - 1]
             errs.append(abs((y[2] - t0b) - (x[2] - t0a)))
@@ -123,11 +170,14 @@ def check_same(orig: str, replayed: str, tol_ms: float) -> int:
     errs.sort()
     worst = errs[-1] if errs else 0
     p99 = errs[int(0.99 * (len(errs) - 1))] if errs else 0
-    print(f"# replay: {n} values equal and in order, {missing} missing; timing error p99 "
-          f"{p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance {tol_ms} ms)")
+    print(f"# replay: {n} values equal and in order, {missing} missing ({tally[0]} coalesced at the producer, "
+          f"{tally[1]} lost on the way); "
+          f"timing error p99 {p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance {tol_ms} ms)")
     if wrong:
         return 1
-    return 3 if missing or worst > tol_ms * 1e6 else 0
+    if worst > tol_ms * 1e6:
+        return 4
+    return 3 if missing else 0
 
 
 def check_throughput(stats_path: str, rate: float) -> int:
@@ -275,15 +325,31 @@ def count_messages(path: str) -> int:
         return sum(1 for _ in make_reader(f).iter_messages())
 
 
+def daemon_losses(paths: list) -> int:
+    """One line: per node, values its ccommd coalesced before sending (a state written
+    twice before the send thread took it), values it saw missing on receipt (sequence
+    gaps), frames lost and socket drops. Prints nothing else; always 0."""
+    parts = []
+    for path in paths:
+        s = json.load(open(path))
+        sig = s.get("signals", [])
+        parts.append("%s: coalesced %d, rx gaps %d, frames lost %d, socket drops %d" % (
+            s.get("node", path), sum(x["coalesced"] for x in sig), sum(x["lost"] for x in sig),
+            sum(p["frames_lost"] for p in s.get("peers", [])), s["counters"].get("socket_drops", 0)))
+    print("# ccommd: " + "; ".join(parts))
+    return 0
+
+
 def main() -> int:
     cmd, args = sys.argv[1], sys.argv[2:]
     if cmd == "config":
         make_config(*args)
         return 0
-    if cmd == "written":
-        return check_written(args[0], args[1], args[2:])
-    if cmd == "same":
-        return check_same(args[0], args[1], float(args[2]))
+    if cmd == "written":  # FILE CONFIG NODE=SENT.json... -- NODE=STATS.json...
+        split = args.index("--")
+        return check_written(args[0], args[1], args[2:split], load_stats(args[split + 1:]))
+    if cmd == "same":  # ORIG REPLAYED MS CONFIG NODE=STATS.json...
+        return check_same(args[0], args[1], float(args[2]), load_stats(args[4:]), args[3])
     if cmd == "throughput":
         return check_throughput(args[0], float(args[1]))
     if cmd == "forge":
@@ -296,6 +362,8 @@ def main() -> int:
         return fuzz(int(args[0]), args[1])
     if cmd == "floor":
         return library_floor(int(args[0]), args[1])
+    if cmd == "daemons":
+        return daemon_losses(args)
     if cmd == "count":
         print(count_messages(args[0]))
         return 0

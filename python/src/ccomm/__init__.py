@@ -29,13 +29,15 @@ from ._errors import (
     VersionError,
 )
 from .client import Client, Reading, Signal, SignalInfo, SignalType, Status
+from .history import History, HistoryReading
 
 # The one version of the Python package: pyproject.toml reads it, and scripts/package
 # checks that it equals the CMake project version and debian/changelog.
 __version__ = "0.1.0"
 
 __all__ = [
-    "BusyError", "CcommError", "Client", "DaemonNotRunningError", "InvalidArgumentError",
+    "BusyError", "CcommError", "Client", "DaemonNotRunningError", "History", "HistoryReading",
+    "InvalidArgumentError",
     "LibraryNotFoundError",
     "NotFoundError", "NotProducerError", "QueueFullError", "Reading", "RetiredError", "Signal",
     "SignalInfo", "SignalType", "Status", "SystemCallError", "TypeMismatchError", "VersionError",

@@ -26,6 +26,17 @@ class Info(ctypes.Structure):
     ]
 
 
+class HistoryCursor(ctypes.Structure):  # ccomm_history_cursor
+    _fields_ = [("next", ctypes.c_uint64), ("overrun", ctypes.c_uint64),
+                ("internal", ctypes.c_uint64 * 3)]
+
+
+class HistoryInfo(ctypes.Structure):  # ccomm_history_info
+    _fields_ = [("seq", ctypes.c_uint64), ("source_time_ns", ctypes.c_uint64),
+                ("receive_time_ns", ctypes.c_uint64), ("overrun", ctypes.c_uint64),
+                ("lost", ctypes.c_uint64)]
+
+
 class SignalDesc(ctypes.Structure):
     _fields_ = [
         ("name", ctypes.c_char_p),
@@ -225,4 +236,11 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
     L.ccomm_view_get_signal.restype = ctypes.c_int
     L.ccomm_view_get_counters.argtypes = [vp, ctypes.POINTER(ViewCounters)]
     L.ccomm_view_get_counters.restype = ctypes.c_int
+    L.ccomm_history_depth.argtypes = [vp, i32]
+    L.ccomm_history_depth.restype = ctypes.c_int
+    L.ccomm_history_start.argtypes = [vp, i32, u32, ctypes.POINTER(HistoryCursor)]
+    L.ccomm_history_start.restype = ctypes.c_int
+    L.ccomm_history_read.argtypes = [vp, i32, ctypes.POINTER(HistoryCursor), vp, ctypes.c_size_t,
+                                     ctypes.POINTER(HistoryInfo)]
+    L.ccomm_history_read.restype = ctypes.c_int
     return L

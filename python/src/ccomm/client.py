@@ -7,12 +7,15 @@ import enum
 import math
 import time
 from dataclasses import dataclass
-from typing import Any, AsyncIterator, Callable, Dict, Iterator, List, Optional, Union
+from typing import TYPE_CHECKING, Any, AsyncIterator, Callable, Dict, Iterator, List, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
 
 from . import _aio, _native, _view
+
+if TYPE_CHECKING:
+    from .history import History
 # The exceptions live in _errors; "X as X" keeps ccomm.client.X working (and typed).
 from ._errors import _check
 from ._errors import (
@@ -220,6 +223,12 @@ class Signal:
             if r is None:
                 return
             yield r
+
+    def history(self, back: int = 1) -> "History":
+        """Every value of this received state from `back` values before the next one on
+        (1: the newest kept too), through the node's history tap (see ccomm.history)."""
+        from .history import History
+        return History(self, back)
 
     def read_into(self, out: npt.NDArray[Any]) -> Reading:
         """Reads into `out` (shape (count,), the signal's dtype), allocating no array.

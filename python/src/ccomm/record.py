@@ -5,6 +5,12 @@ Two processes: this one waits for changes (ccomm_wait) and reads every selected 
 with preallocated buffers, passing each new value (a new seq) as a fixed binary record to
 a writer process through a pipe; the writer (mcap_io.writer) encodes the messages and
 writes the file. So the loop that must keep up with the signals does nothing else.
+
+States the node receives are read through its history tap (signals.xml: <node
+history="N">) when it has one: ccommd keeps their last N values, so a capture loop that
+runs late still gets every value, or a count of those it fell too far behind for (the
+`lost` field). Without the tap they are polled, and a value replaced before the loop
+reads it is missed (a `gap`); the recorder says so when it starts.
 """
 from __future__ import annotations
 
@@ -22,7 +28,7 @@ import time
 from typing import Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
-from .mcap_io.capi import INFO_FORMAT, CcommCallError, Handle, SignalDesc
+from .mcap_io.capi import E_CORRUPT, HISTORY_INFO_FORMAT, INFO_FORMAT, CcommCallError, Handle, SignalDesc
 from .mcap_io.schema import RECORD
 
 EXAMPLES = """\
@@ -32,6 +38,9 @@ examples:
   ccomm-record -s 'wheel*,arm0_pos' -o wheels.mcap
   ccomm-record --rotate-size 100 -o long.mcap    long-0000.mcap, long-0001.mcap, ... of 100 MB
   ccomm-record --recover cut.mcap -o fixed.mcap  a complete file from a truncated one
+
+Every value of the states the node receives needs its history tap, signals.xml:
+<node name="monitor" history="1024" ...> (without it they are polled, with a warning).
 
 Open the file in Foxglove or PlotJuggler, or read it with the `mcap` Python package:
 one channel per signal (topic = signal name), JSON messages with value, seq,
@@ -62,8 +71,9 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
                    help="uncompressed chunk size (default 1 MiB; chunks also close every second)")
     p.add_argument("--priority", type=int, default=0, metavar="N",
-                   help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); a state "
-                        "value replaced before the loop reads it is missed (counted as a gap)")
+                   help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); below "
+                        "ccommd's. Without a history tap a state value replaced before the loop "
+                        "reads it is missed (counted as a gap)")
     p.add_argument("--progress", choices=["auto", "lines", "none"], default="auto",
                    help="progress on stderr: in place on a terminal (auto), a line every 5 s, none")
     p.add_argument("-q", "--quiet", action="store_true", help="same as --progress none")
@@ -145,19 +155,38 @@ class ReadDelay:
     over_1ms = 0
 
 
-def capture(h: Handle, sigs: List[SignalDesc], fd: int, duration: float, stop: List[int],
+def use_history(h: Handle, d: SignalDesc) -> bool:
+    """A state this node receives, and the node keeps history of it (<node history=>)."""
+    return not d.is_event and d.consumed_here and h.history_depth(d.id) > 0
+
+
+def capture(h: Handle, sigs: List[SignalDesc], cursors: list, fd: int, duration: float, stop: List[int],
             writer_alive: Callable[[], bool], delay: ReadDelay) -> int:
-    """Reads every new value of `sigs` until stopped; returns the exit status."""
+    """Reads every new value of `sigs` until stopped; returns the exit status. `cursors`:
+    a history cursor per signal read through the node's history tap, else None."""
     handle, read, wait, now, set_time = h.h, h.read, h.wait, h.now, h.set_time
+    history_read = h.history_read
     info = (ctypes.c_ubyte * struct.calcsize(INFO_FORMAT))()
     info_addr = ctypes.addressof(info)
     unpack_info = struct.Struct(INFO_FORMAT).unpack_from
+    hinfo = (ctypes.c_ubyte * struct.calcsize(HISTORY_INFO_FORMAT))()
+    hinfo_addr = ctypes.addressof(hinfo)
+    unpack_hinfo = struct.Struct(HISTORY_INFO_FORMAT).unpack_from
     pack = RECORD.pack
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
-    # (index, id, buffer address, size, buffer view, is event) per signal, made once
-    items = [(i, d.id, ctypes.addressof(b), d.value_bytes, memoryview(b).cast("B"), d.is_event)
-             for i, (d, b) in enumerate(zip(sigs, bufs))]
+    # A history cursor per received state when the node keeps history (from the newest
+    # value kept: what polling would have read first), else None.
+    # (index, id, buffer address, size, buffer view, is event, history cursor address or 0)
+    items = [(i, d.id, ctypes.addressof(b), d.value_bytes, memoryview(b).cast("B"), d.is_event,
+              ctypes.addressof(cur) if cur is not None else 0)
+             for i, (d, b, cur) in enumerate(zip(sigs, bufs, cursors))]
     last_seq = [0] * len(sigs)
+    # History-read signals: the cursor's overrun at the previous value, and the values lost
+    # before reaching this node so far. A jump in seq is either values the cursor fell too
+    # far behind for (its overrun grew: the recorder missed them, the `gap` says so) or
+    # values that never reached the node (added to `lost`): exact, per value.
+    last_overrun = [0] * len(sigs)
+    lost_so_far = [0] * len(sigs)
     out = bytearray()
     pending = bytearray()
     os.set_blocking(fd, False)
@@ -169,7 +198,32 @@ def capture(h: Handle, sigs: List[SignalDesc], fd: int, duration: float, stop: L
         wait(handle, 100)
         t = now()
         set_time(handle, t)  # ages against t: the arrival time is t - age, exactly
-        for i, sid, addr, size, view, event in items:
+        for i, sid, addr, size, view, event, cursor in items:
+            if cursor:  # every value ccommd stored, in order (see last_overrun above)
+                while True:
+                    r = history_read(handle, sid, cursor, addr, size, hinfo_addr)
+                    if r == E_CORRUPT:  # a damaged copy: skipped, counted in the overrun
+                        continue
+                    if r < 0:
+                        print(f"record: reading {sigs[i].name} failed: {h.strerror(r)}", file=sys.stderr)
+                        return 1
+                    if r != 0:  # EMPTY: caught up
+                        break
+                    seq, src, recv, overrun, lost = unpack_hinfo(hinfo)
+                    age = t - recv
+                    if age > delay.max_ns:
+                        delay.max_ns = age
+                    if age >= 1_000_000:
+                        delay.over_1ms += 1
+                    prev = last_seq[i]
+                    if prev == 0:
+                        lost_so_far[i] = lost  # ccommd's count when recording starts
+                    elif seq > prev + 1:
+                        lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
+                    last_seq[i], last_overrun[i] = seq, overrun
+                    out += pack(sid, 0, 0, seq, recv, src, lost_so_far[i])
+                    out += view
+                continue
             while True:
                 r = read(handle, sid, addr, size, info_addr)
                 if r < 0:
@@ -228,12 +282,22 @@ def record(a: argparse.Namespace) -> int:
     if not h.daemon_alive():
         print(f"record: warning: ccommd of node '{h.node}' shows no heartbeat; recording what "
               "the segment holds", file=sys.stderr)
+    polled = [d.name for d in sigs if not d.is_event and d.consumed_here and not use_history(h, d)]
+    if polled:
+        print(f"record: warning: node '{h.node}' keeps no history of the states it receives "
+              f"({len(polled)} selected, e.g. {polled[0]}): they are polled, and a value replaced before "
+              f"the recorder reads it is missed (a gap in the file). Give the node a history tap in "
+              f'signals.xml (<node name="{h.node}" history="1024" ...>) to record every value.',
+              file=sys.stderr)
     output = a.output or time.strftime(f"ccomm-{h.node}-%Y%m%d-%H%M%S.mcap")
     offset = time.clock_gettime_ns(time.CLOCK_REALTIME) - time.clock_gettime_ns(time.CLOCK_MONOTONIC)
     opts = WriterOptions(output=output, signals=sigs, node=h.node, compression=a.compression,
                          chunk_size=a.chunk_size, rotate_bytes=int(a.rotate_size * 1e6),
                          rotate_seconds=a.rotate_seconds, clock_offset_ns=offset,
                          progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns())
+    # History cursors from the newest value kept (what polling would read first), made
+    # before the start message: every value that arrives after it is recorded.
+    cursors = [h.history_cursor(d.id, 1) if use_history(h, d) else None for d in sigs]
     rfd, wfd = os.pipe()
     try:  # room for about half a second of values at 100 000 values/s
         import fcntl
@@ -274,7 +338,7 @@ def record(a: argparse.Namespace) -> int:
         return not ended
 
     try:
-        code = capture(h, sigs, wfd, a.duration, stop, writer_alive, delay)
+        code = capture(h, sigs, cursors, wfd, a.duration, stop, writer_alive, delay)
     except BrokenPipeError:
         code = 1
     finally:

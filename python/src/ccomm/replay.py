@@ -5,6 +5,7 @@ regression. Values written at the same moment (one control cycle) leave in one f
 from __future__ import annotations
 
 import argparse
+import ctypes
 import fnmatch
 import json
 import os
@@ -14,7 +15,8 @@ import time
 from typing import TYPE_CHECKING, Dict, List, Optional, Sequence, Tuple
 
 from .mcap_io import require_mcap
-from .mcap_io.capi import E_BUSY, E_FULL, OPEN_BATCH, CcommCallError, Handle, SignalDesc
+from .mcap_io.capi import (E_BUSY, E_FULL, OPEN_BATCH, SIGNAL_STATS_BYTES, SIGNAL_STATS_TX_OFFSET,
+                           CcommCallError, Handle, SignalDesc)
 
 if TYPE_CHECKING:
     from .mcap_io.recording import Recording
@@ -112,11 +114,46 @@ def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
            stop: List[int], quiet: bool) -> Tuple[int, List[int]]:
     """Writes the timeline ((source time, seq, signal id, value)); returns (values written,
     lateness of each write in ns)."""
-    handle, write, flush, now = h.h, h.write, h.flush, time.monotonic_ns
+    handle, write, now = h.h, h.write, time.monotonic_ns
+    # A state is sent as its newest value: a step flushed before ccommd took the previous
+    # one would replace it unsent (counted `coalesced` on this node). So each flush first
+    # waits, bounded, until ccommd has taken the previous step: its `tx` counter of a
+    # signal of that step moved. Costs two stats reads a step; waits only when replay runs
+    # late and steps follow each other within ccommd's wake-up time.
+    stats = (ctypes.c_ubyte * SIGNAL_STATS_BYTES)()
+    stats_addr = ctypes.addressof(stats)
+    get_stats, raw_flush = h.get_signal_stats, h.flush
+    probe = [-1, 0]  # a signal of the last flushed step, its tx before that flush
+
+    def tx_of(sid: int) -> int:
+        get_stats(handle, sid, stats_addr)
+        return int.from_bytes(bytes(stats[SIGNAL_STATS_TX_OFFSET:SIGNAL_STATS_TX_OFFSET + 8]), "little")
+
+    no_tx: "set[int]" = set()  # signals ccommd did not send within the bound (not forwarded): no probe
+
+    def flush(hd: int) -> None:
+        if probe[0] >= 0:
+            deadline = now() + 10_000_000
+            while tx_of(probe[0]) <= probe[1]:
+                if now() >= deadline:
+                    no_tx.add(probe[0])
+                    break
+                time.sleep(0.00005)
+            probe[0] = -1
+        if last_sid[0] >= 0 and last_sid[0] not in no_tx:
+            probe[0], probe[1] = last_sid[0], tx_of(last_sid[0])
+            last_sid[0] = -1
+        raw_flush(hd)
+
+    last_sid = [-1]  # a signal written since the last flush
     t0 = timeline[0][0]
     span = timeline[-1][0] - t0
     late: List[int] = []
     written = 0
+    # Signals written since the last flush: a second value of one of them starts a new
+    # step (flush first), so a replay that runs late still hands ccommd every value in its
+    # own step instead of replacing one with the next (a gap in the stream).
+    in_step = bytearray(max(sid for _t, _s, sid, _d in timeline) + 1)
     start = now() + 20_000_000
     last_report = now()
     while not stop:
@@ -125,9 +162,16 @@ def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
             n = now()
             if target > n:
                 flush(handle)  # the values due before now leave together
+                in_step[:] = bytes(len(in_step))
                 time.sleep((target - n) / 1e9)  # clock_nanosleep: about 60 us late at most, idle
                 if stop:
                     break
+            elif in_step[sid]:
+                flush(handle)
+                in_step[:] = bytes(len(in_step))
+            in_step[sid] = 1
+            if sid not in no_tx:
+                last_sid[0] = sid
             r = write(handle, sid, data, len(data))
             tries = 0
             while r in (E_FULL, E_BUSY) and tries < 1000 and not stop:

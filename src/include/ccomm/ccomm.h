@@ -186,6 +186,44 @@ CCOMM_API int ccomm_wait(ccomm_client* c, int timeout_ms);
 CCOMM_API int ccomm_daemon_alive(const ccomm_client* c);
 
 /*
+ * History tap (signals.xml: <node history="N">): every value of a state signal this
+ * node receives, in order, not only the latest. ccommd keeps the last N values of each
+ * received state in a ring; a reader with its own cursor gets each value once, or
+ * learns exactly how many it missed by falling more than N behind (never silently).
+ * For recorders and loggers: lock-free, no syscall, no allocation, never blocks.
+ */
+typedef struct ccomm_history_cursor {
+  uint64_t next;        /**< position of the next value to read */
+  uint64_t overrun;     /**< values this cursor missed (it fell more than N behind) */
+  uint64_t internal[3]; /**< the reader's bookkeeping: set by ccomm_history_start, leave alone */
+} ccomm_history_cursor;
+
+/** What ccomm_history_read returns besides the value. */
+typedef struct ccomm_history_info {
+  uint64_t seq;             /**< producer's sequence number of the value */
+  uint64_t source_time_ns;  /**< producer's CLOCK_MONOTONIC when it wrote the value */
+  uint64_t receive_time_ns; /**< this node's CLOCK_MONOTONIC when ccommd stored it */
+  uint64_t overrun;         /**< the cursor's overrun count (see above) */
+  uint64_t lost;            /**< gaps in the producer's sequence seen by ccommd: values that
+                                 never reached this node */
+} ccomm_history_info;
+
+/** N of signal `s` (> 0), 0 if it has no history ring (an event, not received here, or
+    the node has no history=), CCOMM_E_INVAL for a bad handle or signal. */
+CCOMM_API int ccomm_history_depth(const ccomm_client* c, ccomm_signal s);
+/** Starts `cur` `back` values before the next one to arrive: 0 = only new values, 1 = the
+    newest value kept too, N (or more) = every value kept. Returns 0, CCOMM_E_NOENT if `s`
+    has no history ring, CCOMM_E_INVAL. */
+CCOMM_API int ccomm_history_start(const ccomm_client* c, ccomm_signal s, uint32_t back,
+                                  ccomm_history_cursor* cur);
+/** Next value at `cur`: CCOMM_FRESH with the value (`len` = value_bytes) and `info`,
+    CCOMM_EMPTY when there is none yet (`info` has only overrun and lost), CCOMM_E_CORRUPT
+    (a damaged copy, skipped and counted in overrun), or CCOMM_E_NOENT / E_TYPE / E_INVAL /
+    E_RETIRED as ccomm_read. `info` may be NULL. */
+CCOMM_API int ccomm_history_read(ccomm_client* c, ccomm_signal s, ccomm_history_cursor* cur, void* value,
+                                 size_t len, ccomm_history_info* info);
+
+/*
  * Introspection: the counters ccommd and the clients keep for this node (what
  * `ccomm stats` shows). For tools and monitoring; not real-time calls (they read many
  * words), but they never block and never allocate. Counters only grow.

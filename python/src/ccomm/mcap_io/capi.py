@@ -15,7 +15,7 @@ from typing import List, Optional
 from .. import _native
 
 OPEN_BATCH = 0x2  # CCOMM_OPEN_BATCH: writes are sent together by ccomm_flush()
-E_NOENT, E_TYPE, E_PERM, E_FULL, E_BUSY = -2, -3, -4, -5, -6
+E_NOENT, E_TYPE, E_PERM, E_FULL, E_BUSY, E_CORRUPT = -2, -3, -4, -5, -6, -10
 STATUS_NAMES = ("fresh", "stale", "never", "empty")
 TYPE_NAMES = {1: "bool", 2: "int32", 3: "uint32", 4: "int64", 5: "float", 6: "double"}
 # struct format of one element of each type (little-endian: the segment is host order,
@@ -23,6 +23,12 @@ TYPE_NAMES = {1: "bool", 2: "int32", 3: "uint32", 4: "int64", 5: "float", 6: "do
 TYPE_FORMATS = {"bool": "?", "int32": "i", "uint32": "I", "int64": "q", "float": "f", "double": "d"}
 # ccomm_info as bytes: status, flags, seq, age_ns, source_time_ns, lost
 INFO_FORMAT = "<iIQqQQ"
+# ccomm_history_info as bytes: seq, source_time_ns, receive_time_ns, overrun, lost
+HISTORY_INFO_FORMAT = "<QQQQQ"
+HISTORY_CURSOR_BYTES = 5 * 8  # ccomm_history_cursor
+# ccomm_signal_stats: writes, write_errors, tx, coalesced, rx, lost, overflow,
+# stale_transitions, corrupt, last_rx_age_ns, stale (+ padding)
+SIGNAL_STATS_BYTES, SIGNAL_STATS_TX_OFFSET = 88, 16
 
 
 class CcommCallError(RuntimeError):
@@ -79,6 +85,10 @@ class Handle:
         L.ccomm_now.argtypes = []
         L.ccomm_now.restype = i64
         L.ccomm_daemon_alive.argtypes = [vp]
+        L.ccomm_get_signal_stats.argtypes = [vp, i32, vp]
+        L.ccomm_history_depth.argtypes = [vp, i32]
+        L.ccomm_history_start.argtypes = [vp, i32, ctypes.c_uint32, vp]
+        L.ccomm_history_read.argtypes = [vp, i32, vp, vp, ctypes.c_size_t, vp]
         self.lib = L
         h = vp()
         r = L.ccomm_open(node.encode() if node else None, flags, ctypes.byref(h))
@@ -94,6 +104,8 @@ class Handle:
         self.wait = L.ccomm_wait
         self.set_time = L.ccomm_set_time
         self.now = L.ccomm_now
+        self.history_read = L.ccomm_history_read
+        self.get_signal_stats = L.ccomm_get_signal_stats
 
     def strerror(self, code: int) -> str:
         s: Optional[bytes] = self.lib.ccomm_strerror(code)
@@ -116,6 +128,18 @@ class Handle:
                                   producer=(d.producer or b"").decode(),
                                   stale_after_ms=int(d.stale_after_ms)))
         return out
+
+    def history_depth(self, sid: int) -> int:
+        """Values of signal `sid` the node's history tap keeps (0: none, see <node history=>)."""
+        return max(0, int(self.lib.ccomm_history_depth(self.h, sid)))
+
+    def history_cursor(self, sid: int, back: int) -> "ctypes.Array[ctypes.c_ubyte]":
+        """A ccomm_history_cursor on `sid`, `back` values before the next one to arrive."""
+        cur = (ctypes.c_ubyte * HISTORY_CURSOR_BYTES)()
+        r = self.lib.ccomm_history_start(self.h, sid, back, ctypes.addressof(cur))
+        if r != 0:
+            raise CcommCallError(r, f"ccomm_history_start({sid}): {self.strerror(r)}")
+        return cur
 
     def daemon_alive(self) -> bool:
         return bool(self.lib.ccomm_daemon_alive(self.h))

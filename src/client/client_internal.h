@@ -1,0 +1,16 @@
+// SPDX-License-Identifier: Apache-2.0
+// What libccomm's other units (history.cpp) need of a handle, without the handle's
+// definition (client.cpp).
+#pragma once
+
+#include "ccomm/ccomm.h"
+#include "store/segment.h"
+
+namespace ccomm {
+namespace client {
+
+/// The segment `c` maps (c must not be null).
+const store::Segment& SegmentOf(const ccomm_client* c);
+
+}  // namespace client
+}  // namespace ccomm

@@ -12,6 +12,7 @@
 
 #include "config/config.h"
 #include "daemon/auth.h"
+#include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
@@ -118,6 +119,7 @@ class Daemon {
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from);
+  void HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from);
   /// Rule 5 for one accepted-so-far frame: false if it must be dropped as a duplicate.
   void AccountFrame(const wire::FrameHeader& h, uint64_t now);
   /// Rule 6: the value_seq to store for entry seq `seq` of signal `id`, or 0 to drop it.
@@ -139,6 +141,7 @@ class Daemon {
   bool adopted_ = false;
   Transport transport_;
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
+  SystemView view_;                        // node summaries: ccomm stats --all (system_view.h)
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};

@@ -26,6 +26,7 @@ constexpr size_t kMaxFrameSize = 1472;  // fits a UDP datagram in a 1500-byte MT
 enum FrameFlags : uint8_t {
   kFlagHeartbeat = 1u << 0,  // frame carries no entries, only liveness
   kFlagAuth = 1u << 1,       // a kAuthTagSize-byte tag follows the entries
+  kFlagSummary = 1u << 2,    // payload is a node summary (summary.h), not entries
 };
 
 enum EntryFlags : uint8_t {
@@ -74,6 +75,7 @@ enum class DecodeError : uint8_t {
   kBadHeader,     // reserved bits set, or inconsistent flags / counts
   kBadEntry,      // entry runs past payload, unknown type, count/len mismatch, non-zero padding
   kTrailingBytes, // bytes after the declared payload (and tag)
+  kBadSummary,    // summary frame whose body breaks a rule of summary.h
 };
 const char* DecodeErrorName(DecodeError e);
 
@@ -150,6 +152,9 @@ class FrameWriter {
   uint16_t entries() const { return count_; }
   /// Bytes an entry with value_len value bytes takes on the wire (padded to 8).
   static size_t EntrySize(size_t value_len) { return kEntryHeaderSize + ((value_len + 7u) & ~size_t{7}); }
+  /// Summary frames only (kFlagSummary): reserves `n` (a multiple of 8) payload bytes for
+  /// the caller to fill (summary.cpp); nullptr if it would not fit or the frame is no summary.
+  uint8_t* ReserveBody(size_t n);
 
  private:
   bool AddPreparedGeneric(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, const void* value,

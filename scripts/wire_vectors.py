@@ -19,7 +19,8 @@ import sys
 
 MAGIC = 0x43434D57
 VERSION = 1
-F_HEARTBEAT, F_AUTH = 0x01, 0x02
+F_HEARTBEAT, F_AUTH, F_SUMMARY = 0x01, 0x02, 0x04
+ROLES = {1: "producer", 2: "consumer"}
 E_EVENT, E_FRAGMENT = 0x01, 0x02
 
 # name: (code, element size, struct format)
@@ -96,6 +97,39 @@ class Fragment(Entry):
         ]
 
 
+class Summary:
+    """A node summary body (docs/protocol.md, "Node summary"): head, then records
+    (signal, role, flags, rate_mhz, lost, age_ms); keyword overrides make bad ones."""
+
+    def __init__(self, part, parts, cycle_ms, uptime_ns, peers_alive, counters, records, **bad):
+        self.part, self.parts, self.cycle_ms, self.uptime_ns = part, parts, cycle_ms, uptime_ns
+        self.peers_alive, self.counters, self.records, self.bad = peers_alive, counters, records, bad
+
+    def lines(self):
+        n = self.bad.get("record_count", len(self.records))
+        rx, tx, bad, lost, drops = self.counters
+        out = [
+            ([h("B", self.part), h("B", self.parts), h("H", n), h("I", self.cycle_ms)],
+             "summary: part %d of %d, record_count %d, cycle_ms %d" % (self.part, self.parts, n, self.cycle_ms)),
+            ([h("Q", self.uptime_ns)], "uptime_ns %d" % self.uptime_ns),
+            ([h("Q", self.peers_alive)], "peers_alive %#x" % self.peers_alive),
+            ([h("Q", rx), h("Q", tx)], "frames_rx %d, frames_tx %d" % (rx, tx)),
+            ([h("Q", bad), h("Q", lost), h("Q", drops)], "frames_bad %d, frames_lost %d, socket_drops %d"
+             % (bad, lost, drops)),
+        ]
+        for r in self.records:
+            sig, role, flags, rate, lost_v, age = r[:6]
+            reserved = r[6] if len(r) > 6 else 0
+            out += [
+                ([h("H", sig), h("B", role), h("B", flags), h("I", rate)],
+                 "record: signal %d, role %d (%s), flags %#04x, rate_mhz %d" % (sig, role, ROLES.get(role, "unknown"),
+                                                                               flags, rate)),
+                ([h("Q", lost_v), h("I", age), h("I", reserved)],
+                 "lost %d, age_ms %s, reserved %#x" % (lost_v, "none" if age == 0xFFFFFFFF else age, reserved)),
+            ]
+        return out
+
+
 def fmt_value(tname, v):
     if tname == "bool":
         return "true" if v == 1 else "false" if v == 0 else str(v)
@@ -106,13 +140,14 @@ def fmt_value(tname, v):
 
 class Frame:
     def __init__(self, name, expect, sender, dest, config_hash, seq, time_ns, flags=0,
-                 entries=(), tag=None, note="", **bad):
+                 entries=(), tag=None, note="", summary=None, **bad):
         self.name, self.expect, self.note, self.dest = name, expect, note, dest
+        self.summary = summary  # a Summary: the payload instead of entries
         self.sender, self.config_hash, self.seq, self.time_ns = sender, config_hash, seq, time_ns
         self.flags, self.entries, self.tag, self.bad = flags, list(entries), tag, bad
 
     def lines(self):
-        elines = [l for e in self.entries for l in e.lines()]
+        elines = [l for e in self.entries for l in e.lines()] + (self.summary.lines() if self.summary else [])
         payload = sum(len(b"".join(f)) for f, _ in elines)
         head = [h("I", self.bad.get("magic", MAGIC)), h("B", self.bad.get("version", VERSION)),
                 h("B", self.flags), h("H", self.sender), h("I", self.config_hash), h("I", self.seq)]
@@ -166,6 +201,10 @@ def vectors():
     d = dict(sender=1, dest=2, config_hash=HASH, seq=42, time_ns=2000000500)
     e = dict(sender=3, dest=0, config_hash=HASH, seq=100, time_ns=3000000000)
     s = dict(sender=0, dest=1, config_hash=HASH, seq=1, time_ns=5000000000)
+    sm = dict(sender=2, dest=0, config_hash=HASH, seq=3, time_ns=6000000000, flags=F_SUMMARY)
+    counters = (12000, 11000, 1, 2, 0)
+    recs = [(1, 1, 0x00, 1000000, 0, 1), (4, 2, 0x01, 0, 3, 250)]
+    summ = lambda records=recs, **bad: Summary(0, 1, 1000, 5000000000, 0x3, counters, records, **bad)
     return [
         # Valid frames (expect=ok). wire_test.cpp encodes the same contents.
         Frame("heartbeat", "ok", note="(a) heartbeat from node 2 to every node", **hb),
@@ -181,8 +220,14 @@ def vectors():
         Frame("auth", "ok", sender=1, dest=2, config_hash=HASH, seq=43, time_ns=2000100000, flags=F_AUTH,
               entries=[Entry(9, "int64", [-2], seq=10, time_ns=2000000000)], tag=TAG,
               note="(e) frame with an authentication tag (here 00..0f; the codec does not check it)"),
+        Frame("summary", "ok", summary=summ(),
+              note="(f) node summary from node 2 to node 0: it produces signal 1 at 1000 values/s "
+                   "and consumes signal 4, which is stale", **sm),
+        Frame("summary-empty-part", "ok", sender=5, dest=0xFFFF, config_hash=HASH, seq=0, time_ns=7000000000,
+              flags=F_SUMMARY, summary=Summary(1, 2, 400, 9000000000, 0, (0, 0, 0, 0, 0), []),
+              note="(g) part 1 of 2 without records, node 5 to every node"),
         Frame("fragment", "ok", entries=[frag()],
-              note="(f) fragment entry: the last part (elements 398 and 399) of a `uint32[400]` state value", **fr),
+              note="(h) fragment entry: the last part (elements 398 and 399) of a `uint32[400]` state value", **fr),
         # Malformed frames, each one field away from a valid one.
         Frame("short-header", "too_short", truncate=31, note="the heartbeat cut to 31 bytes", **hb),
         Frame("short-payload", "too_short", entries=[dbl()], truncate=56,
@@ -193,7 +238,10 @@ def vectors():
         Frame("bad-magic", "bad_magic", magic=0x43434D58, note="magic \"CCMX\"", **hb),
         Frame("bad-version", "bad_version", version=2, note="version 2", **hb),
         Frame("unknown-frame-flag", "bad_header", sender=2, dest=0xFFFF, config_hash=HASH, seq=7,
-              time_ns=1000000000, flags=F_HEARTBEAT | 0x04, note="frame flag bit 2 set"),
+              time_ns=1000000000, flags=F_HEARTBEAT | 0x08, note="frame flag bit 3 set"),
+        Frame("summary-heartbeat", "bad_header", sender=2, dest=0xFFFF, config_hash=HASH, seq=7,
+              time_ns=1000000000, flags=F_HEARTBEAT | F_SUMMARY,
+              note="flag bits 0 and 2: a heartbeat that claims to be a summary"),
         Frame("header-reserved", "bad_header", reserved=1, note="header reserved field 1", **hb),
         Frame("heartbeat-with-entry", "bad_header", entries=[ev()], sender=3, dest=0, config_hash=HASH,
               seq=100, time_ns=3000000000, flags=F_HEARTBEAT, note="a heartbeat carries no entries"),
@@ -223,6 +271,23 @@ def vectors():
               note="fragment carrying the whole value (a value that fits is sent unfragmented)", **fr),
         Frame("trailing-byte", "trailing_bytes", trailing=b"\x00",
               note="the heartbeat plus one zero byte", **hb),
+        Frame("summary-with-entry-count", "bad_header", summary=summ(), entry_count=1,
+              note="a summary with entry_count 1 (its body is no entries)", **sm),
+        Frame("summary-short-body", "bad_summary", summary=summ(), payload_len=56, truncate=88,
+              note="a summary body of 56 bytes, shorter than its 64-byte head", **sm),
+        Frame("summary-part-out-of-range", "bad_summary", sender=2, dest=0, config_hash=HASH, seq=3,
+              time_ns=6000000000, flags=F_SUMMARY, summary=Summary(1, 1, 1000, 5000000000, 0x3, counters, recs),
+              note="part 1 of 1 (parts are numbered from 0)"),
+        Frame("summary-count-mismatch", "bad_summary", summary=summ(record_count=3),
+              note="record_count 3 but payload_len holds two records", **sm),
+        Frame("summary-unknown-role", "bad_summary", summary=summ([(1, 3, 0, 0, 0, 1)]),
+              note="record role 3", **sm),
+        Frame("summary-record-flag", "bad_summary", summary=summ([(1, 1, 0x04, 0, 0, 1)]),
+              note="record flag bit 2 set", **sm),
+        Frame("summary-not-increasing", "bad_summary", summary=summ([recs[1], recs[0]]),
+              note="records not in increasing signal order (4, then 1)", **sm),
+        Frame("summary-record-reserved", "bad_summary", summary=summ([(1, 1, 0, 0, 0, 1, 1)]),
+              note="record reserved field 1", **sm),
     ]
 
 
@@ -307,7 +372,13 @@ def main():
                     entries=[Entry(1, "double", [float(i) for i in range(177)])]).data()
         assert len(big) == 1472
         seeds = [(v.name, v.data()) for v in vs]
-        seeds += [("max-frame", big), ("eth-padded-heartbeat", vs[0].data().ljust(46, b"\0"))]
+        full = Frame("max-summary", "ok", sender=1, dest=0xFFFF, config_hash=HASH, seq=1, time_ns=1,
+                     flags=F_SUMMARY | F_AUTH, tag=TAG,
+                     summary=Summary(0, 2, 1000, 1, 0x7, (1, 2, 3, 4, 5),
+                                     [(i, 1 + i % 2, i % 4, i, i, i) for i in range(56)])).data()
+        assert len(full) == 32 + 64 + 56 * 24 + 16
+        seeds += [("max-frame", big), ("eth-padded-heartbeat", vs[0].data().ljust(46, b"\0")),
+                  ("max-summary", full)]
         os.makedirs(args.corpus, exist_ok=True)
         for name, data in seeds:
             with open(os.path.join(args.corpus, name + ".bin"), "wb") as f:

@@ -2,7 +2,7 @@
 """Large values (docs/protocol.md "Large values"): one double array of 1 KiB (one frame)
 and one of 64 KiB (47 fragments) sent board -> board at 100 Hz, one-way latency from the
 producer's write to the reader, and the CPU time both ccommd spent per value. The rows go
-to results.json (section "large"); docs/perf/sections/10-large-values.md reports them."""
+to results.json (section "large"); docs/perf/sections/11-large-values.md reports them."""
 
 import os
 

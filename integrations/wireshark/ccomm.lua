@@ -18,7 +18,8 @@ local ccomm = Proto("ccomm", "ccomm signal frames")
 local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16
 local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46
 local MAGIC, VERSION = 0x43434D57, 1
-local F_HEARTBEAT, F_AUTH, F_KNOWN = 0x01, 0x02, 0x03
+local F_HEARTBEAT, F_AUTH, F_SUMMARY, F_KNOWN = 0x01, 0x02, 0x04, 0x07
+local S_HEAD, S_RECORD, S_MAX = 64, 24, 56  -- node summary body (protocol.md "Node summary")
 local E_EVENT, E_FRAGMENT, E_KNOWN = 0x01, 0x02, 0x03
 local FRAGMENT_HEADER, MAX_FRAGMENTED = 8, 65536  -- fragment sub-header; largest fragmented value
 local DEST_ALL = 0xFFFF
@@ -46,7 +47,8 @@ local f = {
   flags = ProtoField.uint8("ccomm.flags", "flags", base.HEX),
   flag_heartbeat = ProtoField.bool("ccomm.flags.heartbeat", "heartbeat", 8, nil, F_HEARTBEAT),
   flag_auth = ProtoField.bool("ccomm.flags.auth", "authentication tag present", 8, nil, F_AUTH),
-  flag_unknown = ProtoField.uint8("ccomm.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFC),
+  flag_summary = ProtoField.bool("ccomm.flags.summary", "node summary", 8, nil, F_SUMMARY),
+  flag_unknown = ProtoField.uint8("ccomm.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xF8),
   sender = ProtoField.uint16("ccomm.sender", "sender", base.DEC),
   config_hash = ProtoField.uint32("ccomm.config_hash", "config_hash", base.HEX),
   seq = ProtoField.uint32("ccomm.seq", "seq", base.DEC),
@@ -86,6 +88,28 @@ local f = {
   sender_name = ProtoField.string("ccomm.sender_name", "sender node"),
   dest_name = ProtoField.string("ccomm.dest_name", "destination node"),
   e_signal_name = ProtoField.string("ccomm.entry.signal_name", "signal name"),
+  s_body = ProtoField.none("ccomm.summary", "node summary"),
+  s_part = ProtoField.uint8("ccomm.summary.part", "part", base.DEC),
+  s_parts = ProtoField.uint8("ccomm.summary.parts", "parts", base.DEC),
+  s_record_count = ProtoField.uint16("ccomm.summary.record_count", "record_count", base.DEC),
+  s_cycle_ms = ProtoField.uint32("ccomm.summary.cycle_ms", "cycle_ms", base.DEC),
+  s_uptime_ns = ProtoField.uint64("ccomm.summary.uptime_ns", "uptime_ns", base.DEC),
+  s_peers_alive = ProtoField.uint64("ccomm.summary.peers_alive", "peers_alive", base.HEX),
+  s_frames_rx = ProtoField.uint64("ccomm.summary.frames_rx", "frames_rx", base.DEC),
+  s_frames_tx = ProtoField.uint64("ccomm.summary.frames_tx", "frames_tx", base.DEC),
+  s_frames_bad = ProtoField.uint64("ccomm.summary.frames_bad", "frames_bad", base.DEC),
+  s_frames_lost = ProtoField.uint64("ccomm.summary.frames_lost", "frames_lost", base.DEC),
+  s_socket_drops = ProtoField.uint64("ccomm.summary.socket_drops", "socket_drops", base.DEC),
+  r_record = ProtoField.none("ccomm.summary.record", "record"),
+  r_signal = ProtoField.uint16("ccomm.summary.record.signal", "signal", base.DEC),
+  r_role = ProtoField.uint8("ccomm.summary.record.role", "role", base.DEC, { [1] = "producer", [2] = "consumer" }),
+  r_flags = ProtoField.uint8("ccomm.summary.record.flags", "flags", base.HEX),
+  r_flag_stale = ProtoField.bool("ccomm.summary.record.flags.stale", "stale", 8, nil, 0x01),
+  r_flag_never = ProtoField.bool("ccomm.summary.record.flags.never", "never (no value yet)", 8, nil, 0x02),
+  r_rate_mhz = ProtoField.uint32("ccomm.summary.record.rate_mhz", "rate_mhz (values/s x 1000)", base.DEC),
+  r_lost = ProtoField.uint64("ccomm.summary.record.lost", "lost", base.DEC),
+  r_age_ms = ProtoField.uint32("ccomm.summary.record.age_ms", "age_ms", base.DEC),
+  r_reserved = ProtoField.uint32("ccomm.summary.record.reserved", "reserved", base.HEX),
 }
 local field_list = {}
 for _, field in pairs(f) do field_list[#field_list + 1] = field end
@@ -94,7 +118,8 @@ ccomm.fields = field_list
 -- One expert info per DecodeError of docs/protocol.md "Validation", plus the receiver's
 -- bad_signal (rule 6, only with a configuration loaded) and notes.
 local E = {}
-for _, name in ipairs({ "too_short", "bad_magic", "bad_version", "bad_header", "bad_entry", "trailing_bytes" }) do
+for _, name in ipairs({ "too_short", "bad_magic", "bad_version", "bad_header", "bad_entry", "trailing_bytes",
+                        "bad_summary" }) do
   E[name] = ProtoExpert.new("ccomm." .. name, name, expert.group.MALFORMED, expert.severity.ERROR)
 end
 E.bad_signal = ProtoExpert.new("ccomm.bad_signal", "bad_signal", expert.group.PROTOCOL, expert.severity.WARN)
@@ -104,7 +129,7 @@ E.config_error = ProtoExpert.new("ccomm.config_error", "signals.xml not loaded",
                                  expert.severity.WARN)
 E.note = ProtoExpert.new("ccomm.note", "note", expert.group.COMMENTS_GROUP, expert.severity.NOTE)
 ccomm.experts = { E.too_short, E.bad_magic, E.bad_version, E.bad_header, E.bad_entry,
-                  E.trailing_bytes, E.bad_signal, E.config_mismatch, E.config_error, E.note }
+                  E.trailing_bytes, E.bad_summary, E.bad_signal, E.config_mismatch, E.config_error, E.note }
 
 ccomm.prefs.udp_port = Pref.uint("UDP port", 47800, "UDP port of ccomm frames (<network udp_port=...>)")
 ccomm.prefs.ethertype = Pref.uint("EtherType", 0x88B5, "EtherType of raw ccomm frames (<network ethertype=...>)")
@@ -353,6 +378,46 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   return size
 end
 
+-- A node summary's body (SummaryBodyValid): head, then records, within what was captured.
+local S_HEAD_FIELDS = { { "s_part", 0, 1 }, { "s_parts", 1, 1 }, { "s_record_count", 2, 2 }, { "s_cycle_ms", 4, 4 },
+  { "s_uptime_ns", 8, 8 }, { "s_peers_alive", 16, 8 }, { "s_frames_rx", 24, 8 }, { "s_frames_tx", 32, 8 },
+  { "s_frames_bad", 40, 8 }, { "s_frames_lost", 48, 8 }, { "s_socket_drops", 56, 8 } }
+local function dissect_summary(ctx, tvb, len, avail)
+  local function bad(item, text) problem(ctx, item, "bad_summary", text) end
+  local body = ctx.root:add(f.s_body, tvb(HEADER, math.max(0, math.min(len, avail - HEADER))))
+  if len < S_HEAD then return bad(body, string.format("body shorter than its 64-byte head (%d bytes)", len)) end
+  if avail < HEADER + S_HEAD then return end  -- not all there: too_short already says so
+  for _, x in ipairs(S_HEAD_FIELDS) do body:add(f[x[1]], tvb(HEADER + x[2], x[3])) end
+  local part, parts, n = tvb(HEADER, 1):uint(), tvb(HEADER + 1, 1):uint(), tvb(HEADER + 2, 2):uint()
+  ctx.summary_text = string.format(", part %d/%d, %d record%s", part, parts, n, n == 1 and "" or "s")
+  if parts == 0 or part >= parts then bad(body, string.format("part not below parts (%d, %d)", part, parts)) end
+  if n > S_MAX then bad(body, string.format("record_count above 56 (%d)", n)) end
+  if len ~= S_HEAD + n * S_RECORD then bad(body, string.format("payload_len not 64 + 24 x record_count (%d)", len)) end
+  local last, off = -1, HEADER + S_HEAD
+  for i = 0, n - 1 do
+    if off + S_RECORD > HEADER + len or off + S_RECORD > avail then break end
+    local sig, role, rflags = tvb(off, 2):uint(), tvb(off + 2, 1):uint(), tvb(off + 3, 1):uint()
+    local rec = body:add(f.r_record, tvb(off, S_RECORD))
+    rec:append_text(string.format(" %d: signal %s, %s", i, sig, role == 1 and "producer" or role == 2 and "consumer" or "?"))
+    rec:add(f.r_signal, tvb(off, 2))
+    if config.signals[sig] then rec:add(f.e_signal_name, tvb(off, 2), config.signals[sig].name):set_generated() end
+    local role_item = rec:add(f.r_role, tvb(off + 2, 1))
+    local flags_item = rec:add(f.r_flags, tvb(off + 3, 1))
+    flags_item:add(f.r_flag_stale, tvb(off + 3, 1))
+    flags_item:add(f.r_flag_never, tvb(off + 3, 1))
+    rec:add(f.r_rate_mhz, tvb(off + 4, 4))
+    rec:add(f.r_lost, tvb(off + 8, 8))
+    local age_item = rec:add(f.r_age_ms, tvb(off + 16, 4))
+    if tvb(off + 16, 4):uint() == 0xFFFFFFFF then age_item:append_text(" (none)") end
+    local res_item = rec:add(f.r_reserved, tvb(off + 20, 4))
+    if sig <= last then bad(rec, string.format("record %d: signals not strictly increasing (%d after %d)", i, sig, last)) end
+    if role ~= 1 and role ~= 2 then bad(role_item, string.format("record %d: unknown role (%d)", i, role)) end
+    if band(rflags, 0xFC) ~= 0 then bad(flags_item, string.format("record %d: unknown record flag bits (0x%02x)", i, rflags)) end
+    if tvb(off + 20, 4):uint() ~= 0 then bad(res_item, string.format("record %d: reserved not 0", i)) end
+    last, off = sig, off + S_RECORD
+  end
+end
+
 local function dissect(tvb, pinfo, tree)
   local clen = tvb:len()               -- captured bytes
   local rlen = tvb:reported_length_remaining()  -- bytes on the wire (a snap length may cut)
@@ -413,12 +478,14 @@ local function dissect(tvb, pinfo, tree)
   local dest, reserved = tvb(28, 2):uint(), tvb(30, 2):uint()
   local heartbeat = band(flags, F_HEARTBEAT) ~= 0
   local auth = band(flags, F_AUTH) ~= 0
+  local is_summary = band(flags, F_SUMMARY) ~= 0
 
   local magic_item = root:add(f.magic, tvb(0, 4))
   local version_item = root:add(f.version, tvb(4, 1))
   local flags_item = root:add(f.flags, tvb(5, 1))
   flags_item:add(f.flag_heartbeat, tvb(5, 1))
   flags_item:add(f.flag_auth, tvb(5, 1))
+  flags_item:add(f.flag_summary, tvb(5, 1))
   flags_item:add(f.flag_unknown, tvb(5, 1))
   local sender_item = root:add(f.sender, tvb(6, 2))
   if config.nodes[sender] then root:add(f.sender_name, tvb(6, 2), config.nodes[sender]):set_generated() end
@@ -431,9 +498,9 @@ local function dissect(tvb, pinfo, tree)
   if dest == DEST_ALL then dest_item:append_text(" (all nodes)") end
   if config.nodes[dest] then root:add(f.dest_name, tvb(28, 2), config.nodes[dest]):set_generated() end
   local res_item = root:add(f.reserved, tvb(30, 2))
-  local summary = string.format("%s %s -> %s, seq %d", heartbeat and "heartbeat" or "data",
+  local summary = string.format("%s %s -> %s, seq %d", is_summary and "summary" or heartbeat and "heartbeat" or "data",
                                 node_label(sender), node_label(dest), seq)
-  if not heartbeat then summary = summary .. string.format(", %d entr%s", entry_count, entry_count == 1 and "y" or "ies") end
+  if not heartbeat and not is_summary then summary = summary .. string.format(", %d entr%s", entry_count, entry_count == 1 and "y" or "ies") end
 
   -- 2. magic and version: without them the layout of the rest is unknown
   if magic ~= MAGIC then
@@ -447,10 +514,14 @@ local function dissect(tvb, pinfo, tree)
 
   -- 3. the header's own rules
   if band(flags, 0xFF - F_KNOWN) ~= 0 then
-    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", band(flags, 0xFC)))
+    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", band(flags, 0xF8)))
   end
   if reserved ~= 0 then problem(ctx, res_item, "bad_header", string.format("reserved not 0 (0x%04x)", reserved)) end
-  if heartbeat and (entry_count ~= 0 or payload_len ~= 0) then
+  if is_summary then
+    if heartbeat or entry_count ~= 0 or payload_len == 0 then
+      problem(ctx, count_item, "bad_header", "a summary that is also a heartbeat or has entries or no payload")
+    end
+  elseif heartbeat and (entry_count ~= 0 or payload_len ~= 0) then
     problem(ctx, count_item, "bad_header", "a heartbeat with entries or payload")
   elseif not heartbeat and (entry_count == 0 or payload_len == 0) then
     problem(ctx, count_item, "bad_header", "a data frame without entries or payload")
@@ -479,9 +550,14 @@ local function dissect(tvb, pinfo, tree)
   end
 
   -- 5. the entries, within the declared payload (and what was captured)
-  -- (a frame cut short shows its entries up to the end of the captured bytes)
-  local off, left, walked = HEADER, payload_len, true
-  for i = 0, entry_count - 1 do
+  -- (a frame cut short shows its entries up to the end of the captured bytes);
+  -- 7. for a summary its body instead
+  local off, left, walked = HEADER, payload_len, not is_summary
+  if is_summary then
+    dissect_summary(ctx, tvb, payload_len, math.min(flen, clen))
+    summary = summary .. (ctx.summary_text or "")
+  end
+  for i = 0, (is_summary and -1 or entry_count - 1) do
     local size = dissect_entry(ctx, tvb, off, left, i, sender)
     if not size then walked = false; break end
     off, left = off + size, left - size

@@ -68,9 +68,10 @@ def node(build_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterator[
         except subprocess.TimeoutExpired:
             proc.kill()
         log.close()
-        seg = Path("/dev/shm") / (prefix.lstrip("/") + "pytest")
-        if seg.exists():
-            seg.unlink()
+        for name in ("pytest", "pytest.view"):  # the segment and the system view
+            seg = Path("/dev/shm") / (prefix.lstrip("/") + name)
+            if seg.exists():
+                seg.unlink()
 
 
 @pytest.fixture

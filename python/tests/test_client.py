@@ -212,3 +212,18 @@ def test_library_lookup(tmp_path: Path) -> None:
     deep.mkdir(parents=True)
     assert _native.find_library({}, [deep]) == str(lib)
     assert _native.find_library({"CCOMM_BUILD_DIR": str(tmp_path / "build-x")}, []) == str(lib)
+
+
+def test_system_view(client: Client) -> None:
+    # The node's own summary is in the view from ccommd's start; "remote" never ran.
+    v = client.system_view()
+    assert v["node"] == "pytest" and v["summary_ms"] == 1000
+    nodes = {n["name"]: n for n in v["nodes"]}
+    me, remote = nodes["pytest"], nodes["remote"]
+    assert me["self"] and me["reported"] and me["alive"] and me["peers_alive"] == []
+    assert not remote["reported"] and not remote["alive"] and remote["signals"] == []
+    sigs = {s["name"]: s for s in me["signals"]}
+    assert sigs["d"]["role"] == "producer" and sigs["remote_x"]["role"] == "consumer"
+    assert sigs["remote_x"]["stale"] and sigs["remote_x"]["age_ms"] is None  # never received
+    assert len(sigs) == 11  # every signal of the file is produced or consumed here
+    assert v["summaries"]["tx"] >= 1  # sent to "remote" (nobody listens there)

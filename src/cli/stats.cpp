@@ -127,19 +127,24 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
 
 }  // namespace
 
+int CmdStatsAll(ccomm_client* c, bool json, double watch);  // stats_all.cpp
+
 int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
-  bool json = false;
+  bool json = false, all = false;
   double watch = 0;
   static const struct option kLong[] = {{"json", no_argument, nullptr, 'j'},
+                                        {"all", no_argument, nullptr, 'a'},
                                         {"watch", required_argument, nullptr, 'w'},
                                         {nullptr, 0, nullptr, 0}};
   optind = 0;  // 0: GNU getopt fully re-initialises (1 keeps stale permutation state)
   int ch;
-  while ((ch = getopt_long(argc, argv, "jw:", kLong, nullptr)) != -1) {
+  while ((ch = getopt_long(argc, argv, "ajw:", kLong, nullptr)) != -1) {
     if (ch == 'j') json = true;
+    else if (ch == 'a') all = true;
     else if (ch == 'w') watch = strtod(optarg, nullptr);
     else return 2;
   }
+  if (all) return CmdStatsAll(c, json, watch);
   Snapshot before = Take(c);
   if (watch <= 0) {
     // One-shot: measure rates over a short window so RX/S means something.

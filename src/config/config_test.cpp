@@ -104,6 +104,7 @@ TEST(Parse, MinimalConfigGetsDefaults) {
   EXPECT_EQ(cfg.network.udp_port, 47800);
   EXPECT_EQ(cfg.network.heartbeat_ms, 100u);
   EXPECT_EQ(cfg.network.peer_timeout_ms, 300u);
+  EXPECT_EQ(cfg.network.summary_ms, 1000u);
   EXPECT_EQ(cfg.network.auth_key_file, "");
   ASSERT_EQ(cfg.nodes.size(), 1u);
   const NodeConfig& n = cfg.nodes[0];
@@ -140,7 +141,7 @@ TEST(Parse, EverySettingReachesTheModel) {
 <ccomm version="1" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
        xsi:noNamespaceSchemaLocation="signals.xsd">
   <network ethertype="0x88B6" udp_port="40000" heartbeat_ms="50"
-           peer_timeout_ms="200" auth_key_file="/etc/ccomm/k&amp;y.key"/>
+           peer_timeout_ms="200" summary_ms="0" auth_key_file="/etc/ccomm/k&amp;y.key"/>
   <node name="ctl-1" interface="enp3s0" mac="02:AB:cd:00:00:01" ip="10.0.0.1"
         multicast="239.1.2.3" transport="udp">
     <realtime mlockall="false" priority="80" cpu="1" spin_us="200"/>
@@ -167,6 +168,7 @@ TEST(Parse, EverySettingReachesTheModel) {
   EXPECT_EQ(cfg.network.udp_port, 40000);
   EXPECT_EQ(cfg.network.heartbeat_ms, 50u);
   EXPECT_EQ(cfg.network.peer_timeout_ms, 200u);
+  EXPECT_EQ(cfg.network.summary_ms, 0u);  // off
   EXPECT_EQ(cfg.network.auth_key_file, "/etc/ccomm/k&y.key");
   ASSERT_EQ(cfg.nodes.size(), 3u);
   const NodeConfig& n0 = cfg.nodes[0];
@@ -543,6 +545,10 @@ TEST(Parse, NetworkAndNodeEdgeCases) {
       {R"(<network ethertype="0x05FF"/><node name="a" interface="eth0"/>)", "ethertype 0x05FF out of range"},
       {R"(<network ethertype="0x10000"/><node name="a" interface="eth0"/>)", "out of range"},
       {R"(<network udp_port="0"/><node name="a" interface="eth0"/>)", "udp_port 0 out of range (expected 1..65535)"},
+      {R"(<network summary_ms="fast"/><node name="a" interface="eth0"/>)",
+       "invalid summary_ms 'fast' (expected an integer 0..60000)"},
+      {R"(<network summary_ms="60001"/><node name="a" interface="eth0"/>)",
+       "summary_ms 60001 out of range (expected 0..60000)"},
       {R"(<network udp_port="65535"/><node name="a" interface="eth0"/>)", nullptr},
       {R"(<network heartbeat_ms="200"/><node name="a" interface="eth0"/>)", "less than twice"},
       {R"(<network auth_key_file="key"/><node name="a" interface="eth0"/>)", "not an absolute path"},

@@ -195,7 +195,7 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
 }
 
 void Parser::Network(const Node* n, NetworkConfig* net) {
-  Element e(n, {"ethertype", "udp_port", "heartbeat_ms", "peer_timeout_ms", "auth_key_file", "fanout",
+  Element e(n, {"ethertype", "udp_port", "heartbeat_ms", "peer_timeout_ms", "summary_ms", "auth_key_file", "fanout",
                 "multicast_base"},
             &diag_);
   CheckNoText(n, &diag_);
@@ -218,6 +218,10 @@ void Parser::Network(const Node* n, NetworkConfig* net) {
             "heartbeat_ms " + std::to_string(net->heartbeat_ms) +
             " (one lost heartbeat would declare the peer dead)");
   }
+  if (e.Has("summary_ms") && Unsigned(e, "summary_ms", 0, kMaxSummaryMs, &net->summary_ms) &&
+      net->summary_ms != 0 && net->summary_ms < kMinSummaryMs)
+    Err(e.Get("summary_ms")->line, "summary_ms " + std::to_string(net->summary_ms) + " is below " +
+                                       std::to_string(kMinSummaryMs) + " (0 turns summaries off)");
   if (const AttrValue* a = e.Get("fanout")) {
     if (a->value == "unicast")
       net->fanout = Fanout::kUnicast;

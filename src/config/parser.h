@@ -24,6 +24,7 @@ constexpr uint32_t kMaxPeriodUs = 60u * 1000 * 1000;
 constexpr uint32_t kMaxStaleAfterMs = 3600u * 1000;
 constexpr uint32_t kMaxHeartbeatMs = 10000;
 constexpr uint32_t kMaxPeerTimeoutMs = 60000;
+constexpr uint32_t kMinSummaryMs = 100, kMaxSummaryMs = 60000;
 constexpr uint32_t kMaxSpinUs = 100000;
 constexpr int kMaxCpu = 1023;  // CPU_SETSIZE - 1
 constexpr uint32_t kMinQueueDepth = 2;

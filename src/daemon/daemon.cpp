@@ -144,6 +144,8 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       if (r != 0) return r;
     }
   }
+  r = view_.Start(cfg, node_id, kind, opt.force_udp, &segment_, &transport_, &auth_, gid, error);
+  if (r != 0) return r;
 
   uint64_t now = platform::MonotonicNs();
   for (uint32_t id : periodic_) due_ns_[id] = now;
@@ -187,6 +189,7 @@ void Daemon::Supervise(uint64_t now) {
           cfg_->network.peer_timeout_ms);
     }
   }
+  view_.Tick(now);  // this node's summary, rate-limited (system_view.h)
   for (uint32_t id : consumed_) {
     const SignalConfig& s = cfg_->signals[id];
     if (!s.stale_after_ms) continue;

@@ -12,6 +12,7 @@
 
 #include "config/config.h"
 #include "daemon/auth.h"
+#include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
@@ -108,12 +109,18 @@ class Daemon {
   void CountBadEntry(uint16_t signal, const wire::FrameHeader& h);
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
-  void SettleSteps(uint32_t steps_before);
+  void SettleSteps(uint32_t steps_before, uint64_t now);
+  /// Adds the values of state `id` written after `last_sent` and before the newest one
+  /// (value_seq `newest`) that its slots still hold, oldest first; returns how many of
+  /// them are gone (replaced before ccommd took them: coalesced).
+  uint64_t CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
+                   uint64_t now);
   void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
                 const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from);
+  void HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from);
   /// Rule 5 for one accepted-so-far frame: false if it must be dropped as a duplicate.
   void AccountFrame(const wire::FrameHeader& h, uint64_t now);
   /// Rule 6: the value_seq to store for entry seq `seq` of signal `id`, or 0 to drop it.
@@ -151,6 +158,7 @@ class Daemon {
   bool adopted_ = false;
   Transport transport_;
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
+  SystemView view_;                        // node summaries: ccomm stats --all (system_view.h)
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};
@@ -188,6 +196,7 @@ class Daemon {
   bool sending_large_ = false;
   bool large_refusal_logged_ = false;
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
+  alignas(8) uint8_t tx_older_[kMaxValueBytes];  // CatchUp's copy of an older value
   alignas(8) uint8_t rx_value_[kMaxValueBytes];
   alignas(8) uint8_t rx_buf_[2048];
 };

@@ -101,6 +101,10 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     Count(store::kFramesAuthFailed);
     return;
   }
+  if (h.flags & wire::kFlagSummary) {  // a node summary, from any node: not a data frame
+    HandleSummary(buf, h, now, from);
+    return;
+  }
   if (h.sender >= peers_rx_.size() || h.sender == self_ || !peers_tx_[h.sender].active) {
     Count(store::kFramesUnknownSender);
     return;

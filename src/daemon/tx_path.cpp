@@ -105,19 +105,46 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   uint64_t& last = last_tx_seq_[id];
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
-  if (!periodic && (last || !adopted_) && m.value_seq > last + 1)
-    segment_.stats(id).coalesced.fetch_add(m.value_seq - last - 1, std::memory_order_relaxed);
+  if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {
+    const uint64_t gone = CatchUp(id, d, last, m.value_seq, now);
+    if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
+  }
   last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 
 
+// An event-driven state sends every value once. When its writer was faster than this
+// thread (ccommd descheduled, a late cycle writing two steps back to back), the values
+// between the last one sent and the newest are usually still in the cell's slots
+// (kStateSlots copies): they go out first, in order, in the same frame, so a recorder or
+// history tap downstream gets every value and nothing is coalesced. Bounded by
+// kStateSlots - 1 reads; a value already overwritten counts as coalesced.
+uint64_t Daemon::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
+                         uint64_t now) {
+  const store::StateView& sv = tx_state_[id];
+  const uint64_t first = newest - last_sent - 1 >= store::kStateSlots ? newest - (store::kStateSlots - 1) : last_sent + 1;
+  uint64_t gone = first - last_sent - 1;
+  for (uint64_t seq = first; seq < newest; ++seq) {
+    store::SlotMeta om;
+    const store::StoreResult r = store::StateReadTicket(sv, seq - 1, tx_older_, &om);
+    if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
+    if (r != store::StoreResult::kOk || om.value_seq != seq) {
+      ++gone;
+      continue;
+    }
+    AddEntry(id, d, 0, om, tx_older_, now);
+  }
+  return gone;
+}
+
 // A batch step stores its signals one after another; if one landed while this round was
 // collecting, the frames may hold some of its values and the previous step's others. So
-// the round waits for steps in progress (bounded), then brings every state value it took
-// up to date in the frames still open: a step's outputs leave together, whatever the
-// timing of ccommd against the writers. The common case costs two loads.
-void Daemon::SettleSteps(uint32_t steps_before) {
+// the round waits for steps in progress (bounded), then appends the newer values of every
+// state it took to the frames still open (after the older ones, see CatchUp): each step's
+// outputs leave together and in order, whatever the timing of ccommd against the writers.
+// The common case costs two loads.
+void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
   store::SegmentHeader* h = segment_.header();
   for (int pass = 0; pass < 8; ++pass) {
     for (int spin = 0; spin < 4096 && h->steps_active.load(std::memory_order_acquire) != 0; ++spin)
@@ -126,22 +153,20 @@ void Daemon::SettleSteps(uint32_t steps_before) {
     if (steps_now == steps_before) return;
     steps_before = steps_now;
     for (uint32_t id : collected_states_) {
-      store::StateView sv = segment_.state(id);
+      const store::StateView& sv = tx_state_[id];
       const uint64_t version = store::StateVersion(sv);
       if (version == store::StateForwarded(sv)) continue;  // unchanged since it was taken
       store::SlotMeta m;
       if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) continue;
       store::MarkStateForwarded(sv, version);
-      for (uint32_t peer : consumers_[id]) {
-        PeerTx& p = peers_tx_[peer];
-        if (p.open)
-          p.writer.Rewrite(static_cast<uint16_t>(id), static_cast<uint32_t>(m.value_seq), m.source_time_ns, tx_value_);
-      }
-      // The value taken first (counted in tx) is replaced in the frame: it and any written
-      // between never leave, so they count as coalesced, as in CollectSignal.
-      if (m.value_seq > last_tx_seq_[id])
-        segment_.stats(id).coalesced.fetch_add(m.value_seq - last_tx_seq_[id], std::memory_order_relaxed);
-      last_tx_seq_[id] = m.value_seq;
+      uint64_t& last = last_tx_seq_[id];
+      if (m.value_seq <= last) continue;
+      // The newer step's values follow the ones already in the frame (and any between,
+      // from the slots): each step leaves whole, in order, and nothing is replaced.
+      const uint64_t gone = m.value_seq > last + 1 ? CatchUp(id, segment_.dir(id), last, m.value_seq, now) : 0;
+      if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
+      last = m.value_seq;
+      AddEntry(id, segment_.dir(id), 0, m, tx_value_, now);
     }
   }
 }
@@ -171,7 +196,7 @@ void Daemon::RunTx() {
           CollectSignal(id, now, false);
       }
     }
-    SettleSteps(steps_before);
+    SettleSteps(steps_before, now);
     // Idle, the loop wakes once per heartbeat (or more often if the service watchdog
     // needs it to advance sooner, see idle_sleep_ns_).
     uint64_t next_deadline = now + idle_sleep_ns_;

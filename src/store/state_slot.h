@@ -184,6 +184,16 @@ __attribute__((always_inline)) inline StoreResult StateRead(const StateView& v, 
   return StateReadCopies(v, out, meta, v.value_bytes);
 }
 
+/// Copies the value of ticket t if its slot still holds it, complete: a state keeps its
+/// last kStateSlots copies, so the sender can still forward values a writer replaced
+/// before ccommd took them (values numbered by the store are ticket + 1). kOk, kEmpty
+/// (overwritten, being rewritten, or never written), or kCorrupt (its check failed).
+inline StoreResult StateReadTicket(const StateView& v, uint64_t t, void* out, SlotMeta* meta) {
+  const CopyResult r = ReadSlot(v.slot(t), t, v.value_bytes, out, meta);
+  if (r == CopyResult::kOk) return StoreResult::kOk;
+  return r == CopyResult::kCorrupt ? StoreResult::kCorrupt : StoreResult::kEmpty;
+}
+
 /// `latest` counter: changes whenever a new value is published (cheap change check).
 inline uint64_t StateVersion(const StateView& v) {
   return v.cell->latest.load(std::memory_order_acquire);

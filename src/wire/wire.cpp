@@ -7,6 +7,7 @@
 #include "wire/wire.h"
 
 #include "common/value_type.h"
+#include "wire/summary.h"
 
 #include <cstring>
 
@@ -44,7 +45,7 @@ constexpr size_t kOffMagic = 0, kOffVersion = 4, kOffFlags = 5, kOffSender = 6, 
 constexpr size_t kEOffSignal = 0, kEOffType = 2, kEOffFlags = 3, kEOffCount = 4, kEOffLen = 6,
                  kEOffSeq = 8, kEOffReserved = 12, kEOffTime = 16;
 
-constexpr uint8_t kKnownFrameFlags = kFlagHeartbeat | kFlagAuth;
+constexpr uint8_t kKnownFrameFlags = kFlagHeartbeat | kFlagAuth | kFlagSummary;
 constexpr uint8_t kKnownEntryFlags = kEntryEvent | kEntryFragment;
 constexpr size_t kFOffTotal = kEntryHeaderSize, kFOffOffset = kEntryHeaderSize + 4;
 constexpr uint8_t kTypeBool = static_cast<uint8_t>(ValueType::kBool);
@@ -162,6 +163,7 @@ const char* DecodeErrorName(DecodeError e) {
     case DecodeError::kBadHeader: return "bad_header";
     case DecodeError::kBadEntry: return "bad_entry";
     case DecodeError::kTrailingBytes: return "trailing_bytes";
+    case DecodeError::kBadSummary: return "bad_summary";
   }
   return "unknown";
 }
@@ -191,7 +193,7 @@ void FrameWriter::Begin(const FrameHeader& h) {
 bool FrameWriter::Add(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
                       uint64_t source_time_ns, const void* value, size_t value_len) {
   if (len_ < kHeaderSize) return false;                 // no successful Begin
-  if (buf_[kOffFlags] & kFlagHeartbeat) return false;  // heartbeats carry no entries
+  if (buf_[kOffFlags] & (kFlagHeartbeat | kFlagSummary)) return false;  // no entries there
   if (count_ == UINT16_MAX) return false;
   const size_t esize = ValueTypeSize(type);
   if (esize == 0 || count == 0 || value_len != size_t{count} * esize) return false;
@@ -289,26 +291,19 @@ bool FrameWriter::AddFragment(uint16_t signal, uint8_t type, uint8_t flags, uint
   return true;
 }
 
-bool FrameWriter::Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value) {
-  if (len_ < kHeaderSize) return false;
-  size_t off = kHeaderSize;
-  for (uint16_t i = 0; i < count_; ++i) {  // bounded: the entries this writer added
-    uint8_t* p = buf_ + off;
-    const size_t value_len = Load<uint16_t>(p + kEOffLen);
-    if (Load<uint16_t>(p + kEOffSignal) == signal && !(p[kEOffFlags] & (kEntryEvent | kEntryFragment))) {
-      Store<uint32_t>(p + kEOffSeq, seq);
-      Store<uint64_t>(p + kEOffTime, source_time_ns);
-      EncodeValue(p + kEntryHeaderSize, value, ValueTypeSize(p[kEOffType]), Load<uint16_t>(p + kEOffCount));
-      return true;
-    }
-    off += EntryValueOffset(p) + Padded(value_len);
-  }
-  return false;
+uint8_t* FrameWriter::ReserveBody(size_t n) {
+  if (len_ < kHeaderSize || !(buf_[kOffFlags] & kFlagSummary) || n % 8 != 0) return nullptr;
+  if (n > limit_ - len_) return nullptr;
+  uint8_t* p = buf_ + len_;
+  len_ += n;
+  return p;
 }
 
 size_t FrameWriter::Finish() {
   if (len_ < kHeaderSize) return 0;
-  if (count_ == 0 && !(buf_[kOffFlags] & kFlagHeartbeat)) return 0;
+  const uint8_t flags = buf_[kOffFlags];
+  if ((flags & kFlagSummary) && ((flags & kFlagHeartbeat) || len_ == kHeaderSize)) return 0;
+  if (count_ == 0 && !(flags & (kFlagHeartbeat | kFlagSummary))) return 0;
   Store<uint16_t>(buf_ + kOffCount, count_);
   Store<uint16_t>(buf_ + kOffPayload, static_cast<uint16_t>(len_ - kHeaderSize));
   return len_;
@@ -327,8 +322,11 @@ DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const ui
   if (Load<uint16_t>(buf + kOffReserved) != 0) return DecodeError::kBadHeader;
   const uint16_t entry_count = Load<uint16_t>(buf + kOffCount);
   const uint16_t payload_len = Load<uint16_t>(buf + kOffPayload);
-  // One encoding per meaning: heartbeats are exactly the frames without entries.
-  if (flags & kFlagHeartbeat) {
+  // One encoding per meaning: heartbeats are exactly the frames without entries; a
+  // summary carries its own body instead of entries (summary.h) and is no heartbeat.
+  if (flags & kFlagSummary) {
+    if ((flags & kFlagHeartbeat) || entry_count != 0 || payload_len == 0) return DecodeError::kBadHeader;
+  } else if (flags & kFlagHeartbeat) {
     if (entry_count != 0 || payload_len != 0) return DecodeError::kBadHeader;
   } else if (entry_count == 0 || payload_len == 0) {
     return DecodeError::kBadHeader;
@@ -341,6 +339,10 @@ DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const ui
 
   const uint8_t* p = buf + kHeaderSize;
   size_t left = payload_len;
+  if (flags & kFlagSummary) {
+    if (!SummaryBodyValid(p, payload_len)) return DecodeError::kBadSummary;
+    left = 0;  // the body is the whole payload (entry_count is 0)
+  }
   for (uint16_t i = 0; i < entry_count; ++i) {
     size_t size = 0;
     if (left >= kEntryHeaderSize) {

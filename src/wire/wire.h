@@ -26,6 +26,7 @@ constexpr size_t kMaxFrameSize = 1472;  // fits a UDP datagram in a 1500-byte MT
 enum FrameFlags : uint8_t {
   kFlagHeartbeat = 1u << 0,  // frame carries no entries, only liveness
   kFlagAuth = 1u << 1,       // a kAuthTagSize-byte tag follows the entries
+  kFlagSummary = 1u << 2,    // payload is a node summary (summary.h), not entries
 };
 
 enum EntryFlags : uint8_t {
@@ -88,6 +89,7 @@ enum class DecodeError : uint8_t {
   kBadHeader,     // reserved bits set, or inconsistent flags / counts
   kBadEntry,      // entry runs past payload, unknown type, count/len mismatch, non-zero padding
   kTrailingBytes, // bytes after the declared payload (and tag)
+  kBadSummary,    // summary frame whose body breaks a rule of summary.h
 };
 const char* DecodeErrorName(DecodeError e);
 
@@ -160,9 +162,6 @@ class FrameWriter {
   /// and offset, a strict part of the value, total at most kMaxFragmentedValue).
   bool AddFragment(uint16_t signal, uint8_t type, uint8_t flags, uint16_t count, uint32_t seq,
                    uint64_t source_time_ns, uint32_t offset, const void* part, size_t part_len);
-  /// Replaces the value, seq and source time of the (non-event) entry of `signal` already
-  /// in this frame, re-encoded as Add does (same type and count). False if absent.
-  bool Rewrite(uint16_t signal, uint32_t seq, uint64_t source_time_ns, const void* value);
   /// Writes entry_count / payload_len into the header; returns the frame length
   /// without any auth tag, or 0 if Begin failed (cap < kHeaderSize, unknown flag bits)
   /// or a frame without kFlagHeartbeat has no entry (such a frame is invalid).
@@ -187,6 +186,9 @@ class FrameWriter {
     return (kMaxFrameSize - kHeaderSize - kEntryHeaderSize - kFragmentHeaderSize - (auth ? kAuthTagSize : 0)) &
            ~size_t{7};
   }
+  /// Summary frames only (kFlagSummary): reserves `n` (a multiple of 8) payload bytes for
+  /// the caller to fill (summary.cpp); nullptr if it would not fit or the frame is no summary.
+  uint8_t* ReserveBody(size_t n);
 
  private:
   bool AddPreparedGeneric(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, const void* value,

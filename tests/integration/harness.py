@@ -118,9 +118,10 @@ class NodePair:
         for ns in self.ns.values():
             run(["ip", "netns", "del", ns], check=False)
         for node in self.ns:
-            path = "/dev/shm/" + self.env["CCOMM_SHM_PREFIX"].lstrip("/") + node
-            if os.path.exists(path):
-                os.unlink(path)
+            for suffix in ("", ".view"):  # the segment and the system view (ccomm stats --all)
+                path = "/dev/shm/" + self.env["CCOMM_SHM_PREFIX"].lstrip("/") + node + suffix
+                if os.path.exists(path):
+                    os.unlink(path)
 
     def exec_prefix(self, node):
         return ["ip", "netns", "exec", self.ns[node]]

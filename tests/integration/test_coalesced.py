@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Every state write is either sent or counted coalesced (writes == tx + coalesced), also
-for values replaced before ccommd sent the first one: a NO_DOORBELL handle writes twice
-before ccommd looks (it only looks at its next wake-up, within heartbeat_ms), then twice
-again. The planner receives the last value of each pair. (tests/manyboards found
-writes == tx + coalesced + 1.)"""
+for values written before ccommd sent the first one, and values a writer replaced before
+ccommd looked still leave while the cell's slots hold them (tx_path.cpp, CatchUp): a
+NO_DOORBELL handle writes twice before ccommd looks (it only looks at its next wake-up,
+within heartbeat_ms): both are sent; then six times: the last four are sent (a state
+keeps four copies), the two before them are counted coalesced, and the planner counts
+exactly that gap as lost. (tests/manyboards found writes == tx + coalesced + 1.)"""
 import os
 import subprocess
 
@@ -27,7 +29,8 @@ assert lib.ccomm_open(b"control", ctypes.c_uint32(0x1), ctypes.byref(h)) == 0  #
 x = lib.ccomm_find(h, b"x")
 lib.ccomm_write_double(h, x, 1.0); lib.ccomm_write_double(h, x, 2.0)  # both before ccommd looks
 time.sleep(0.3)                                                        # > heartbeat_ms: 2 was sent
-lib.ccomm_write_double(h, x, 3.0); lib.ccomm_write_double(h, x, 4.0)
+for v in range(3, 9):
+    lib.ccomm_write_double(h, x, float(v))                             # 3..8 before ccommd looks
 time.sleep(0.3)
 """
 
@@ -43,11 +46,11 @@ def test_values_replaced_before_the_first_send_count_as_coalesced(tmp_path):
                            env=python_env(pair.env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                            timeout=30)
         assert w.returncode == 0, w.stdout
-        assert wait_for(lambda: signal_stats(pair.stats("planner"), "x")["rx"] >= 2, 5) is not None
+        assert wait_for(lambda: signal_stats(pair.stats("planner"), "x")["rx"] >= 6, 5) is not None
         prod = signal_stats(pair.stats("control"), "x")
         cons = signal_stats(pair.stats("planner"), "x")
-    assert prod["writes"] == 4, prod
-    assert (prod["tx"], prod["coalesced"]) == (2, 2), prod
-    # The planner sees the gap 2 -> 4 only: a receiver starts counting at the first value it
-    # gets (it cannot tell a replaced first value from joining late).
-    assert (cons["rx"], cons["lost"]) == (2, 1), cons
+        last = pair.echo_once("planner", "x")
+    assert prod["writes"] == 8, prod
+    assert (prod["tx"], prod["coalesced"]) == (6, 2), prod  # 1, 2, then 5..8 sent; 3, 4 gone
+    assert (cons["rx"], cons["lost"]) == (6, 2), cons       # the gap 2 -> 5, exactly
+    assert float(last[0]) == 8.0, last

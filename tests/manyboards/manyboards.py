@@ -272,7 +272,9 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
                 % (n * a.signals, n, "" if every else " or counted lost (TODO above)",
                    "monitor=\"*\", no consumers= lists it" if monitor == "attr" else "listed in every consumers="))
     # Each cycle's flush leaves as one frame per destination: one to the group (multicast)
-    # or one per consumer node (unicast). Frames = values sent of any one signal x that.
+    # or one per consumer node (unicast). Frames = values sent of any one signal x that,
+    # or fewer: when ccommd ran late, one frame carries two cycles (the older one from the
+    # cells' slots, tx_path.cpp CatchUp); never more, and at most 1 % merged.
     per_cycle, off = {}, []
     for j, name in enumerate(nodes):
         data = sent_after[j]["data"] - sent_before[j]["data"]
@@ -283,10 +285,11 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
         else:
             dests = 1 if fanout == "multicast" else min(a.consumers, n - 1) + (1 if monitor == "list" else 0)
             sent = res[name]["produced"]["%s_s0" % name]["tx"]
-        if data != sent * dests:
+        if data > sent * dests or data < 0.99 * sent * dests:
             off.append("%s %d frames for %d cycles sent x %d" % (name, data, sent, dests))
     want = 1 if fanout == "multicast" else min(a.consumers, n - 1) + (1 if monitor == "list" else 0)
-    r.check(not off, "data frames counted on the bridge = %d per producing board per cycle sent (%s; median "
+    r.check(not off, "data frames counted on the bridge = %d per producing board per cycle sent, or one for "
+            "two cycles after a late round (%s; median "
             "%.4f per cycle)%s" % (want, fanout, median([per_cycle[config.board(i)] for i in range(n)]),
                                    "" if not off else ": " + "; ".join(off[:6])))
     hb = {name: sent_after[j]["heartbeat"] - sent_before[j]["heartbeat"] for j, name in enumerate(nodes)}

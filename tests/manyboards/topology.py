@@ -6,8 +6,8 @@ lives in a namespace of its own (PREFIX-sw), so nothing touches the host's names
 The bridge snoops IGMP and is its own querier, so UDP multicast reaches only the ports
 that joined a group; raw Ethernet multicast (no snooping exists for it) is flooded.
 Neighbours are permanent entries (no ARP). nftables counters (bridge prerouting) count
-what each board SENDS: ccomm data frames and heartbeats separately (flags bit 0), for
-raw (EtherType 0x88B5) and UDP (port 47800) alike.
+what each board SENDS: ccomm data frames and heartbeats separately (flags bit 0; node
+summaries, bit 2, only in the total), for raw (EtherType 0x88B5) and UDP (port 47800) alike.
 """
 
 import json
@@ -90,9 +90,10 @@ class Topology:
         rules = []
         for i in range(self.n):
             p = 'iifname "p%d" ' % i
-            rules += [p + 'ether type 0x%x @nh,40,8 & 0x01 == 0x00 counter name "d%d"' % (ETHERTYPE, i),
+            # data: neither heartbeat (bit 0) nor node summary (bit 2, counted in "a" only)
+            rules += [p + 'ether type 0x%x @nh,40,8 & 0x05 == 0x00 counter name "d%d"' % (ETHERTYPE, i),
                       p + 'ether type 0x%x @nh,40,8 & 0x01 == 0x01 counter name "h%d"' % (ETHERTYPE, i),
-                      p + 'udp dport %d @th,104,8 & 0x01 == 0x00 counter name "d%d"' % (UDP_PORT, i),
+                      p + 'udp dport %d @th,104,8 & 0x05 == 0x00 counter name "d%d"' % (UDP_PORT, i),
                       p + 'udp dport %d @th,104,8 & 0x01 == 0x01 counter name "h%d"' % (UDP_PORT, i),
                       p + 'counter name "a%d"' % i]
         counters = "".join("  counter %s%d {}\n" % (k, i) for i in range(self.n) for k in "dha")

@@ -127,8 +127,10 @@ adopted=$(cat "$WORK"/ccommd-*.log | grep -c 're-adopted')
 created=$(cat "$WORK"/ccommd-*.log | grep -c '(created)')
 figure "ccommd starts: $adopted re-adopted the existing segment, $created created one"
 check "restarted daemons re-adopted their segments ($adopted >= $ADOPT_EXPECTED)" [ "$adopted" -ge "$ADOPT_EXPECTED" ]
-segs=$(ls /dev/shm | grep -c "^$TAG\.")
-check "no stale segment left behind (2 segments: $(ls /dev/shm | grep "^$TAG\." | tr '\n' ' '))" [ "$segs" -eq 2 ]
+segs=$(ls /dev/shm | grep "^$TAG\." | grep -vc '\.view$')
+views=$(ls /dev/shm | grep -c "^$TAG\..*\.view$")  # each ccommd start replaces its node's system view
+check "no stale segment left behind (2 segments, 2 system views: $(ls /dev/shm | grep "^$TAG\." | tr '\n' ' '))" \
+  [ "$segs" -eq 2 -a "$views" -eq 2 ]
 
 # End to end and local: new values arrive at the planner and locally, fresh.
 seq_of() { cli "$1" echo "$2" --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p'; }

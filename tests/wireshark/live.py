@@ -97,7 +97,8 @@ def capture(harness, transport, seconds, work, ts):
 
 
 def analyse(ts, pcap, transport, sent, nodes, signals, want_hash):
-    fields = ["ccomm.sender", "ccomm.dest", "ccomm.seq", "ccomm.flags.heartbeat", "ccomm.config_hash",
+    fields = ["ccomm.sender", "ccomm.dest", "ccomm.seq", "ccomm.flags.heartbeat", "ccomm.flags.summary",
+              "ccomm.config_hash",
               "ccomm.entry.signal", "ccomm.entry.type", "ccomm.entry.count", "ccomm.entry.flags",
               "ccomm.decode_error", "_ws.expert.message", "_ws.expert.severity", "_ws.lua.text",
               "eth.type", "udp.dstport"]
@@ -112,8 +113,10 @@ def analyse(ts, pcap, transport, sent, nodes, signals, want_hash):
         if p["ccomm.config_hash"][0] != "0x" + want_hash:
             bad.append("config_hash %s" % p["ccomm.config_hash"][0])
         encaps.add("udp %s" % p["udp.dstport"][0] if "udp.dstport" in p else "eth %s" % p.get("eth.type", ["?"])[0])
-        seqs.setdefault((sender, dest), []).append(seq)
-        if p["ccomm.flags.heartbeat"][0] not in ("1", "True"):
+        # node summaries have a frame sequence of their own (protocol.md, "Node summary")
+        summary = p.get("ccomm.flags.summary", ["0"])[0] in ("1", "True")
+        seqs.setdefault((sender, dest, summary), []).append(seq)
+        if not summary and p["ccomm.flags.heartbeat"][0] not in ("1", "True"):
             data[sender] = data.get(sender, 0) + 1
         for sid, typ, cnt, fl in zip(p.get("ccomm.entry.signal", []), p.get("ccomm.entry.type", []),
                                      p.get("ccomm.entry.count", []), p.get("ccomm.entry.flags", [])):
@@ -134,9 +137,10 @@ def analyse(ts, pcap, transport, sent, nodes, signals, want_hash):
               % (transport, node, data.get(node_id, 0), span(entries.get(node_id, set())), len(want)))
     gaps = {k: [b for a, b in zip(sorted(v), sorted(v)[1:]) if b != a + 1] for k, v in seqs.items()}
     check(all(not g for g in gaps.values()), "%s: frame seq contiguous per (sender, dest) %s"
-          % (transport, {"%d->%d" % k: "%d..%d" % (min(v), max(v)) for k, v in seqs.items()}))
+          % (transport, {"%d->%d%s" % (k[0], k[1], " summary" if k[2] else ""): "%d..%d" % (min(v), max(v))
+                         for k, v in seqs.items()}))
     for (node, peer), count in sorted(sent.items()):
-        got = sum(len(v) for (s, d), v in seqs.items() if s == nodes.index(node))
+        got = sum(len(v) for (s, d, summ), v in seqs.items() if s == nodes.index(node) and not summ)
         check(got >= count, "%s: %s -> %s: %d frames captured, daemon counted %d sent while the apps ran"
               % (transport, node, peer, got, count))
 

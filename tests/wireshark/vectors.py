@@ -33,7 +33,11 @@ FIELDS = ["ccomm.magic", "ccomm.version", "ccomm.flags", "ccomm.sender", "ccomm.
           "ccomm.entry.signal", "ccomm.entry.type", "ccomm.entry.flags", "ccomm.entry.count",
           "ccomm.entry.value_len", "ccomm.entry.seq", "ccomm.entry.reserved", "ccomm.entry.source_time_ns",
           "ccomm.entry.value", "ccomm.entry.total_len", "ccomm.entry.offset", "ccomm.auth_tag", "ccomm.decode_error", "_ws.expert.message",
-          "_ws.expert.severity", "_ws.malformed", "_ws.lua.text"] + \
+          "_ws.expert.severity", "_ws.malformed", "_ws.lua.text", "ccomm.summary.part", "ccomm.summary.parts",
+          "ccomm.summary.record_count", "ccomm.summary.cycle_ms", "ccomm.summary.uptime_ns",
+          "ccomm.summary.frames_rx", "ccomm.summary.record.signal", "ccomm.summary.record.role",
+          "ccomm.summary.record.flags", "ccomm.summary.record.rate_mhz", "ccomm.summary.record.lost",
+          "ccomm.summary.record.age_ms"] + \
          ["ccomm.entry.value." + t for t in TYPE_NAMES.values()]
 failures = []
 
@@ -92,6 +96,22 @@ def check_valid(pkt, v, where):
                     ("ccomm.entry.source_time_ns", [str(e.time_ns) for e in v.entries])):
         if entry_field(k) != want:
             fail("%s: %s = %s, expected %s" % (where, k, entry_field(k), want))
+    if v.summary:  # a node summary: its head and records as the encoder wrote them
+        sm = v.summary
+        recs = sm.records
+        for k, want in (("ccomm.summary.part", [str(sm.part)]), ("ccomm.summary.parts", [str(sm.parts)]),
+                        ("ccomm.summary.record_count", [str(len(recs))]),
+                        ("ccomm.summary.cycle_ms", [str(sm.cycle_ms)]),
+                        ("ccomm.summary.uptime_ns", [str(sm.uptime_ns)]),
+                        ("ccomm.summary.frames_rx", [str(sm.counters[0])]),
+                        ("ccomm.summary.record.signal", [str(r[0]) for r in recs]),
+                        ("ccomm.summary.record.role", [str(r[1]) for r in recs]),
+                        ("ccomm.summary.record.flags", ["0x%02x" % r[2] for r in recs]),
+                        ("ccomm.summary.record.rate_mhz", [str(r[3]) for r in recs]),
+                        ("ccomm.summary.record.lost", [str(r[4]) for r in recs]),
+                        ("ccomm.summary.record.age_ms", [str(r[5]) for r in recs])):
+            if entry_field(k) != want:
+                fail("%s: %s = %s, expected %s" % (where, k, entry_field(k), want))
     # values: the text field and the typed elements, compared as numbers of their type
     texts = entry_field("ccomm.entry.value")
     typed = {t: list(entry_field("ccomm.entry.value." + t)) for t in TYPE_NAMES.values()}

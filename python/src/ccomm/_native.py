@@ -51,6 +51,51 @@ class SignalDesc(ctypes.Structure):
     ]
 
 
+class ViewNode(ctypes.Structure):
+    """ccomm_view_node (ccomm.h, system view)."""
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("is_self", ctypes.c_int32),
+        ("reported", ctypes.c_int32),
+        ("alive", ctypes.c_int32),
+        ("age_ns", ctypes.c_int64),
+        ("timeout_ns", ctypes.c_int64),
+        ("uptime_ns", ctypes.c_uint64),
+        ("peers_alive", ctypes.c_uint64),
+        ("frames_rx", ctypes.c_uint64),
+        ("frames_tx", ctypes.c_uint64),
+        ("frames_bad", ctypes.c_uint64),
+        ("frames_lost", ctypes.c_uint64),
+        ("socket_drops", ctypes.c_uint64),
+        ("cycle_ms", ctypes.c_uint32),
+        ("summaries", ctypes.c_uint64),
+    ]
+
+
+class ViewSignal(ctypes.Structure):
+    """ccomm_view_signal."""
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("role", ctypes.c_int32),
+        ("stale", ctypes.c_int32),
+        ("rate", ctypes.c_double),
+        ("lost", ctypes.c_uint64),
+        ("age_ns", ctypes.c_int64),
+    ]
+
+
+class ViewCounters(ctypes.Structure):
+    """ccomm_view_counters."""
+    _fields_ = [
+        ("summaries_tx", ctypes.c_uint64),
+        ("summaries_rx", ctypes.c_uint64),
+        ("summaries_refused", ctypes.c_uint64),
+        ("summaries_old", ctypes.c_uint64),
+        ("summaries_send_errors", ctypes.c_uint64),
+        ("summary_ms", ctypes.c_uint32),
+    ]
+
+
 def _repo_roots(starts: Sequence[Path]) -> list[Path]:
     """Directories above `starts` that look like a ccomm source tree."""
     roots: list[Path] = []
@@ -179,6 +224,18 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
     L.ccomm_now.restype = ctypes.c_int64
     L.ccomm_daemon_alive.argtypes = [vp]
     L.ccomm_daemon_alive.restype = ctypes.c_int
+    L.ccomm_node_count.argtypes = [vp]
+    L.ccomm_node_count.restype = ctypes.c_int
+    L.ccomm_view_open.argtypes = [vp, ctypes.POINTER(vp)]
+    L.ccomm_view_open.restype = ctypes.c_int
+    L.ccomm_view_close.argtypes = [vp]
+    L.ccomm_view_close.restype = None
+    L.ccomm_view_get_node.argtypes = [vp, ctypes.c_int, ctypes.POINTER(ViewNode)]
+    L.ccomm_view_get_node.restype = ctypes.c_int
+    L.ccomm_view_get_signal.argtypes = [vp, ctypes.c_int, i32, ctypes.POINTER(ViewSignal)]
+    L.ccomm_view_get_signal.restype = ctypes.c_int
+    L.ccomm_view_get_counters.argtypes = [vp, ctypes.POINTER(ViewCounters)]
+    L.ccomm_view_get_counters.restype = ctypes.c_int
     L.ccomm_history_depth.argtypes = [vp, i32]
     L.ccomm_history_depth.restype = ctypes.c_int
     L.ccomm_history_start.argtypes = [vp, i32, u32, ctypes.POINTER(HistoryCursor)]

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, AsyncIterator, Callable, Dict, Iterator, 
 import numpy as np
 import numpy.typing as npt
 
-from . import _aio, _native
+from . import _aio, _native, _view
 
 if TYPE_CHECKING:
     from .history import History
@@ -448,3 +448,9 @@ class Client:
     def daemon_alive(self) -> bool:
         """ccommd updated its heartbeat within the last second."""
         return bool(_native.lib().ccomm_daemon_alive(self._handle()))
+
+    def system_view(self) -> Dict[str, Any]:
+        """Every node of the system as this board's ccommd knows it from the node
+        summaries: the same dict as `ccomm stats --all --json` (nodes with alive, peers,
+        counters, and per signal role, rate, lost, stale, age_ms; None for never)."""
+        return _view.system_view(self._handle())

@@ -274,6 +274,74 @@ CCOMM_API int ccomm_get_daemon_counter(const ccomm_client* c, int index, const c
 /** How many times a ccommd created or re-adopted this node's segment (1 = first start). */
 CCOMM_API uint32_t ccomm_daemon_generation(const ccomm_client* c);
 
+/*
+ * System view: what this node's ccommd learned from every node's summary (uptime, the
+ * peers it hears, its counters, per signal it produces or consumes: rate, loss,
+ * staleness), sent between the ccommd's at most once per 100 ms each (`<network
+ * summary_ms>`, docs/protocol.md "Node summary"). What `ccomm stats --all` shows. Not
+ * real-time calls; they never block and never allocate after ccomm_view_open.
+ */
+typedef struct ccomm_view ccomm_view;
+
+/** ccomm_view_signal.role */
+#define CCOMM_ROLE_PRODUCER 1
+#define CCOMM_ROLE_CONSUMER 2
+
+/**
+ * Maps the view of the node `c` is attached to (read-only). `c` must stay open while the
+ * view is used. CCOMM_E_NOENT: no view (no ccommd running, or one older than the view);
+ * CCOMM_E_VERSION: a view of another layout.
+ */
+CCOMM_API int ccomm_view_open(const ccomm_client* c, ccomm_view** out);
+CCOMM_API void ccomm_view_close(ccomm_view* v);
+
+/** One node, as its newest summary describes it. */
+typedef struct ccomm_view_node {
+  const char* name;        /**< valid until ccomm_close of the client */
+  int32_t is_self;         /**< the node this view belongs to (its own summary) */
+  int32_t reported;        /**< 1 once a summary of it arrived (else only name is set) */
+  int32_t alive;           /**< its last summary is younger than `timeout_ns` */
+  int64_t age_ns;          /**< since its last summary arrived; -1 if never */
+  int64_t timeout_ns;      /**< three of its summary intervals, at least peer_timeout_ms */
+  uint64_t uptime_ns;      /**< its ccommd's uptime when it sent that summary */
+  uint64_t peers_alive;    /**< bit i set: it hears node i */
+  uint64_t frames_rx, frames_tx, frames_bad;
+  uint64_t frames_lost;    /**< gaps in its peers' frame sequences, summed */
+  uint64_t socket_drops;
+  uint32_t cycle_ms;       /**< its time to send its whole summary once */
+  uint64_t summaries;      /**< summary parts of it applied here */
+} ccomm_view_node;
+/** Fills `out`; CCOMM_E_INVAL for a bad handle or node index, CCOMM_E_BUSY if the record
+ *  was being rewritten throughout (retry). */
+CCOMM_API int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out);
+
+/** One signal as node `node` reports it. */
+typedef struct ccomm_view_signal {
+  const char* name;   /**< valid until ccomm_close of the client */
+  int32_t role;       /**< CCOMM_ROLE_PRODUCER or CCOMM_ROLE_CONSUMER at that node */
+  int32_t stale;      /**< consumer: older than its stale_after_ms (or never received);
+                           also 1 for any signal of a node that is not alive (report outdated) */
+  double rate;        /**< values per second over the node's last summary cycle (producer:
+                           writes; consumer: values received) */
+  uint64_t lost;      /**< consumer: sequence gaps; producer: writes refused */
+  int64_t age_ns;     /**< since the last value (consumer: arrived; producer: written), as the
+                           node measured it when it sent its summary (see the node's age_ns);
+                           -1 if never */
+} ccomm_view_signal;
+/** Fills `out`; CCOMM_E_NOENT if that node does not report (produce or consume) the signal
+ *  or no summary of it arrived yet; CCOMM_E_INVAL for a bad handle, node or signal. */
+CCOMM_API int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out);
+
+/** Summary traffic of this node's ccommd (counters only grow). */
+typedef struct ccomm_view_counters {
+  uint64_t summaries_tx, summaries_rx;
+  uint64_t summaries_refused;  /**< unknown sender or signal, wrong source, config or destination */
+  uint64_t summaries_old;      /**< not newer than the sender's last one (duplicates) */
+  uint64_t summaries_send_errors;
+  uint32_t summary_ms;         /**< this node's <network summary_ms> (0: it sends none) */
+} ccomm_view_counters;
+CCOMM_API int ccomm_view_get_counters(const ccomm_view* v, ccomm_view_counters* out);
+
 #ifdef __cplusplus
 }
 #endif

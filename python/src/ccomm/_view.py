@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Client.system_view(): the view of every node that ccommd gathered from the node
+summaries (ccomm.h, ccomm_view_*; what `ccomm stats --all --json` prints)."""
+from __future__ import annotations
+
+import ctypes
+from typing import Any, Dict, List
+
+from . import _native
+from ._errors import _check
+
+_ROLES = {1: "producer", 2: "consumer"}
+
+
+def system_view(handle: int) -> Dict[str, Any]:
+    L = _native.lib()
+    v = ctypes.c_void_p()
+    _check(L.ccomm_view_open(handle, ctypes.byref(v)), "system view")
+    try:
+        vc = _native.ViewCounters()
+        _check(L.ccomm_view_get_counters(v, ctypes.byref(vc)), "system view")
+        names: List[str] = []
+        nodes: List[Dict[str, Any]] = []
+        n_signals = L.ccomm_signal_count(handle)
+        for n in range(L.ccomm_node_count(handle)):
+            vn = _native.ViewNode()
+            _check(L.ccomm_view_get_node(v, n, ctypes.byref(vn)), "system view")
+            names.append(vn.name.decode())
+            signals = []
+            for s in range(n_signals):
+                vs = _native.ViewSignal()
+                if L.ccomm_view_get_signal(v, n, s, ctypes.byref(vs)) != 0:
+                    continue  # the node neither produces nor consumes it (or no report yet)
+                signals.append({"name": vs.name.decode(), "role": _ROLES.get(vs.role, str(vs.role)),
+                                "rate": vs.rate, "lost": vs.lost, "stale": bool(vs.stale),
+                                "age_ms": vs.age_ns / 1e6 if vs.age_ns >= 0 else None})
+            nodes.append({"name": names[-1], "self": bool(vn.is_self), "reported": bool(vn.reported),
+                          "alive": bool(vn.alive), "age_ms": vn.age_ns / 1e6 if vn.age_ns >= 0 else None,
+                          "timeout_ms": vn.timeout_ns / 1e6, "uptime_s": vn.uptime_ns / 1e9,
+                          "peers_alive": vn.peers_alive, "frames_rx": vn.frames_rx, "frames_tx": vn.frames_tx,
+                          "frames_bad": vn.frames_bad, "frames_lost": vn.frames_lost,
+                          "socket_drops": vn.socket_drops, "cycle_ms": vn.cycle_ms, "summaries": vn.summaries,
+                          "signals": signals})
+        for node in nodes:  # the bit mask as names, as the CLI prints it
+            mask = node["peers_alive"]
+            node["peers_alive"] = [names[i] for i in range(min(len(names), 64)) if mask >> i & 1]
+        return {"node": L.ccomm_node_name(handle).decode(), "summary_ms": vc.summary_ms,
+                "summaries": {"tx": vc.summaries_tx, "rx": vc.summaries_rx, "refused": vc.summaries_refused,
+                              "old": vc.summaries_old, "send_errors": vc.summaries_send_errors},
+                "nodes": nodes}
+    finally:
+        L.ccomm_view_close(v)

@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccomm_view_*: the system view (store/view.h) ccommd keeps from the node summaries,
+// read-only, through the seqlock of each node record. Names come from the client's
+// segment through the public API.
+#include <errno.h>
+
+#include <new>
+
+#include "ccomm/ccomm.h"
+#include "store/view.h"
+
+struct ccomm_view {
+  const ccomm_client* client = nullptr;
+  ccomm::store::View view;
+};
+
+namespace {
+
+namespace st = ccomm::store;
+constexpr uint32_t kNoAge = 0xFFFFFFFFu;  // wire::kSummaryNoAge
+
+const char* NodeName(const ccomm_view* v, int node) {
+  ccomm_peer_stats ps;
+  return ccomm_get_peer_stats(v->client, node, &ps) == 0 ? ps.name : "";
+}
+
+bool Alive(const st::ViewNodeCopy& n, int64_t now) {
+  const uint64_t last = n.w[st::kVwLastRxNs];
+  return last != 0 && (static_cast<uint64_t>(now) <= last || static_cast<uint64_t>(now) - last <= n.w[st::kVwTimeoutNs]);
+}
+
+}  // namespace
+
+extern "C" {
+
+int ccomm_view_open(const ccomm_client* c, ccomm_view** out) {
+  if (!c || !out) return CCOMM_E_INVAL;
+  *out = nullptr;
+  ccomm_view* v = new (std::nothrow) ccomm_view;
+  if (!v) return CCOMM_E_SYS;
+  v->client = c;
+  const int r = v->view.OpenReadOnly(st::View::NameFor(ccomm_node_name(c)));
+  const st::ViewHeader* h = r == 0 ? v->view.header() : nullptr;
+  if (r != 0 || static_cast<int>(h->node_count) != ccomm_node_count(c) ||
+      static_cast<int>(h->signal_count) != ccomm_signal_count(c)) {
+    delete v;
+    // -EPROTO: another layout version; a view of other dimensions belongs to another
+    // configuration than the client's segment (ccommd restarted with a new one).
+    return r == -ENOENT ? CCOMM_E_NOENT : r == -EPROTO ? CCOMM_E_VERSION : r ? CCOMM_E_SYS : CCOMM_E_RETIRED;
+  }
+  *out = v;
+  return 0;
+}
+
+void ccomm_view_close(ccomm_view* v) { delete v; }
+
+int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out) {
+  if (!v || !out || node < 0 || node >= static_cast<int>(v->view.header()->node_count)) return CCOMM_E_INVAL;
+  st::ViewNodeCopy n;
+  if (!v->view.ReadNode(static_cast<uint32_t>(node), &n)) return CCOMM_E_BUSY;
+  const int64_t now = ccomm_now();
+  *out = ccomm_view_node();
+  out->name = NodeName(v, node);
+  out->is_self = static_cast<uint32_t>(node) == v->view.header()->self;
+  out->reported = n.w[st::kVwLastRxNs] != 0;
+  out->alive = Alive(n, now);
+  out->age_ns = out->reported ? now - static_cast<int64_t>(n.w[st::kVwLastRxNs]) : -1;
+  if (out->age_ns < -1) out->age_ns = 0;
+  out->timeout_ns = static_cast<int64_t>(n.w[st::kVwTimeoutNs]);
+  out->uptime_ns = n.w[st::kVwUptimeNs];
+  out->peers_alive = n.w[st::kVwPeersAlive];
+  out->frames_rx = n.w[st::kVwFramesRx];
+  out->frames_tx = n.w[st::kVwFramesTx];
+  out->frames_bad = n.w[st::kVwFramesBad];
+  out->frames_lost = n.w[st::kVwFramesLost];
+  out->socket_drops = n.w[st::kVwSocketDrops];
+  out->cycle_ms = static_cast<uint32_t>(n.w[st::kVwCycleMs]);
+  out->summaries = n.w[st::kVwSummaries];
+  return 0;
+}
+
+int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out) {
+  if (!v || !out || node < 0 || node >= static_cast<int>(v->view.header()->node_count) || s < 0 ||
+      s >= static_cast<int>(v->view.header()->signal_count))
+    return CCOMM_E_INVAL;
+  st::ViewRowCopy r;
+  st::ViewNodeCopy n;
+  if (!v->view.ReadRow(static_cast<uint32_t>(node), static_cast<uint32_t>(s), &r) ||
+      !v->view.ReadNode(static_cast<uint32_t>(node), &n))
+    return CCOMM_E_BUSY;
+  if (!r.present) return CCOMM_E_NOENT;
+  const int64_t now = ccomm_now();
+  ccomm_signal_desc d;
+  *out = ccomm_view_signal();
+  out->name = ccomm_describe(v->client, s, &d) == 0 ? d.name : "";
+  out->role = r.role;
+  out->rate = static_cast<double>(r.rate_mhz) / 1000.0;
+  out->lost = r.lost;
+  // As the node measured it when it sent the report (node age_ns says how old that is).
+  out->age_ns = r.age_ms == kNoAge ? -1 : static_cast<int64_t>(r.age_ms) * 1000000;
+  out->stale = (r.flags & 1u) != 0 || !Alive(n, now);  // wire::kRecordStale; or an outdated report
+  return 0;
+}
+
+int ccomm_view_get_counters(const ccomm_view* v, ccomm_view_counters* out) {
+  if (!v || !out) return CCOMM_E_INVAL;
+  const st::ViewHeader* h = v->view.header();
+  out->summaries_tx = h->summaries_tx.load(std::memory_order_relaxed);
+  out->summaries_rx = h->summaries_rx.load(std::memory_order_relaxed);
+  out->summaries_refused = h->summaries_refused.load(std::memory_order_relaxed);
+  out->summaries_old = h->summaries_old.load(std::memory_order_relaxed);
+  out->summaries_send_errors = h->summaries_send_errors.load(std::memory_order_relaxed);
+  out->summary_ms = h->summary_ms;
+  return 0;
+}
+
+}  // extern "C"

@@ -59,8 +59,10 @@ const RosType* RosTypeFor(int32_t ccomm_type, uint32_t count);
 struct RouteCounters {
   std::atomic<uint64_t> published{0};       // samples written to DDS
   std::atomic<uint64_t> skipped{0};         // state values overwritten before the bridge read them
+                                            // (with a history tap: the bridge fell N behind)
   std::atomic<uint64_t> stale{0};           // fresh -> stale transitions (ROS sees a deadline miss)
-  std::atomic<uint64_t> lost{0};            // events ccomm reported lost before the bridge
+  std::atomic<uint64_t> lost{0};            // events ccomm reported lost before the bridge, and
+                                            // states that never reached this node (history tap)
   std::atomic<uint64_t> dds_errors{0};      // dds_write/take failures
   std::atomic<uint64_t> received{0};        // DDS samples taken
   std::atomic<uint64_t> written{0};         // of those, written into ccomm
@@ -82,6 +84,9 @@ struct Route {
   uint64_t last_seq = 0;    // to_ros: seq of the last value published
   uint64_t last_lost = 0;   // to_ros: the handle's lost count already counted
   bool fresh = false;       // to_ros: the last read was fresh
+  bool history = false;     // to_ros: a received state read through the node's history tap
+  ccomm_history_cursor cursor{};  // ... its cursor (every value, in order)
+  uint64_t last_overrun = 0;      // ... the cursor's overrun already counted
   RouteCounters n;
 };
 

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccomm -> ROS 2: wakes on every change of the node's signals (ccomm_wait), reads each
 // published signal straight into its preallocated DDS sample and writes it with the
-// ccomm write time as source timestamp. Nothing is allocated per sample here.
+// ccomm write time as source timestamp. Nothing is allocated per sample here. A state
+// this node receives is read through the history tap when the node has one
+// (<node history="N">): every value is published, not only the newest at each wake-up.
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -53,11 +55,52 @@ bool Publish(Bridge* b, Route* r, const ccomm_info& info) {
   return false;
 }
 
+// Every value of a state the history tap kept since the last call, in order.
+int PumpHistory(Bridge* b, ccomm_client* c, Route* r) {
+  void* value = ValueOf(r);
+  for (int i = 0; i < 100000; ++i) {  // bounded: a writer faster than us cannot pin us here
+    ccomm_history_info hi;
+    const int st = ccomm_history_read(c, r->id, &r->cursor, value, r->desc.value_bytes, &hi);
+    if (st == CCOMM_E_CORRUPT) continue;  // skipped and counted in the cursor's overrun
+    if (st < 0) return st;
+    const uint64_t overran = hi.overrun > r->last_overrun ? hi.overrun - r->last_overrun : 0;
+    if (overran) r->n.skipped.fetch_add(overran, std::memory_order_relaxed);
+    r->last_overrun = hi.overrun;
+    if (st != CCOMM_FRESH) break;
+    // A gap the cursor did not overrun: values that never reached this node.
+    const uint64_t gap = r->last_seq != 0 && hi.seq > r->last_seq + 1 ? hi.seq - r->last_seq - 1 : 0;
+    if (gap > overran) r->n.lost.fetch_add(gap - overran, std::memory_order_relaxed);
+    r->last_seq = hi.seq;
+    ccomm_info info{};
+    info.status = CCOMM_FRESH;
+    info.seq = hi.seq;
+    info.source_time_ns = hi.source_time_ns;
+    const int64_t now = ccomm_now();
+    info.age_ns = now > static_cast<int64_t>(hi.receive_time_ns) ? now - static_cast<int64_t>(hi.receive_time_ns) : 0;
+    Publish(b, r, info);
+  }
+  return 0;
+}
+
 // Reads one signal and publishes what is new and fresh. Returns a ccomm error (< 0)
 // that needs a reopen, else 0.
 int Pump(Bridge* b, ccomm_client* c, Route* r) {
   void* value = ValueOf(r);
   ccomm_info info;
+  if (r->history) {
+    const int err = PumpHistory(b, c, r);
+    if (err < 0) return err;
+    // Freshness from the newest value, as below (ROS 2 readers see the DDS deadline).
+    const int st = ccomm_read(c, r->id, value, r->desc.value_bytes, &info);
+    if (st < 0) return st;
+    if (st != CCOMM_FRESH && r->fresh) {
+      r->fresh = false;
+      r->n.stale.fetch_add(1, std::memory_order_relaxed);
+    } else if (st == CCOMM_FRESH) {
+      r->fresh = true;
+    }
+    return 0;
+  }
   if (r->desc.is_event) {  // every queued event, in order, once
     for (int i = 0; i < 100000; ++i) {  // bounded: a writer faster than us cannot pin us here
       int st = ccomm_read(c, r->id, value, r->desc.value_bytes, &info);
@@ -90,6 +133,19 @@ int Pump(Bridge* b, ccomm_client* c, Route* r) {
   return 0;
 }
 
+// A state value already there counts as seen, not new; a received state with a history
+// tap is read from the next value on.
+void StartRoutes(ccomm_client* c, const std::vector<Route*>& routes) {
+  for (Route* r : routes) {
+    r->last_seq = r->last_lost = r->last_overrun = 0;
+    r->history = !r->desc.is_event && ccomm_history_depth(c, r->id) > 0 &&
+                 ccomm_history_start(c, r->id, 0, &r->cursor) == 0;
+    ccomm_info info;
+    if (!r->desc.is_event && ccomm_read(c, r->id, ValueOf(r), r->desc.value_bytes, &info) >= 0)
+      r->last_seq = info.seq;
+  }
+}
+
 }  // namespace
 
 void RunToRos(Bridge* b) {
@@ -106,11 +162,7 @@ void RunToRos(Bridge* b) {
   ccomm_client* c = OpenWaiting(b);
   if (!c) return;
   if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }
-  for (Route* r : b->to_ros) {  // a state value already there counts as seen, not new
-    ccomm_info info;
-    if (!r->desc.is_event && ccomm_read(c, r->id, ValueOf(r), r->desc.value_bytes, &info) >= 0)
-      r->last_seq = info.seq;
-  }
+  StartRoutes(c, b->to_ros);
   while (!b->stop.load(std::memory_order_relaxed)) {
     ccomm_wait(c, 100);  // returns at once on a change; 100 ms to notice stop/retirement
     int err = 0;
@@ -126,7 +178,7 @@ void RunToRos(Bridge* b) {
       if (!c) return;
       if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; break; }
       b->reopens.fetch_add(1, std::memory_order_relaxed);
-      for (Route* r : b->to_ros) r->last_seq = r->last_lost = 0;  // a new segment counts anew
+      StartRoutes(c, b->to_ros);  // a new segment counts anew
     } else if (err < 0) {
       fprintf(stderr, "ccomm-ros2: reading signals: %s\n", ccomm_strerror(err));
       b->fatal = 1;

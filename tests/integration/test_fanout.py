@@ -78,7 +78,8 @@ def test_fanout(transport, fanout):
         receivers = 1 if fanout == "multicast" else 3
         slack = receivers * (int(elapsed / 0.1) + 4)
         assert receivers * ps["tx"] <= frames <= receivers * VALUES + slack, (frames, elapsed)
-        assert frames <= on_wire <= frames + 10, (frames, on_wire)  # + the kernel's own (ARP, IGMP)
+        # + the kernel's own (ARP, IGMP); - the odd frame a veth drops in a burst on a loaded host
+        assert frames - 5 <= on_wire <= frames + 10, (frames, on_wire)
         if fanout == "multicast":
             # x exchanges nothing with p: none of p's frames may reach its ccommd (with
             # unicast fan-out, raw frames to nodes without mac= are broadcast to all).

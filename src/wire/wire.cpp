@@ -15,28 +15,9 @@ namespace ccomm {
 namespace wire {
 namespace {
 
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
-inline uint16_t Swap(uint16_t v) { return v; }
-inline uint32_t Swap(uint32_t v) { return v; }
-inline uint64_t Swap(uint64_t v) { return v; }
-#else
-inline uint16_t Swap(uint16_t v) { return __builtin_bswap16(v); }
-inline uint32_t Swap(uint32_t v) { return __builtin_bswap32(v); }
-inline uint64_t Swap(uint64_t v) { return __builtin_bswap64(v); }
-#endif
-
-template <typename T>
-inline T Load(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return Swap(v);
-}
-
-template <typename T>
-inline void Store(uint8_t* p, T v) {
-  v = Swap(v);
-  std::memcpy(p, &v, sizeof v);
-}
+// Big-endian field access: one definition, wire.h's.
+using be::Load;
+using be::Store;
 
 // Field offsets, see docs/protocol.md.
 constexpr size_t kOffMagic = 0, kOffVersion = 4, kOffFlags = 5, kOffSender = 6, kOffHash = 8,

@@ -93,7 +93,7 @@ enum class DecodeError : uint8_t {
 };
 const char* DecodeErrorName(DecodeError e);
 
-/// Big-endian loads and stores for the inline paths below (wire.cpp has its own).
+/// Big-endian loads and stores: every encoder and decoder of the wire module uses these.
 namespace be {
 template <typename T>
 inline T Swap(T v) {

@@ -25,7 +25,7 @@ import signal
 import struct
 import sys
 import time
-from typing import Callable, List, Optional, Sequence
+from typing import Any, Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
 from .mcap_io.capi import E_CORRUPT, HISTORY_INFO_FORMAT, INFO_FORMAT, CcommCallError, Handle, SignalDesc
@@ -160,7 +160,7 @@ def use_history(h: Handle, d: SignalDesc) -> bool:
     return not d.is_event and d.consumed_here and h.history_depth(d.id) > 0
 
 
-def capture(h: Handle, sigs: List[SignalDesc], cursors: list, fd: int, duration: float, stop: List[int],
+def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, duration: float, stop: List[int],
             writer_alive: Callable[[], bool], delay: ReadDelay) -> int:
     """Reads every new value of `sigs` until stopped; returns the exit status. `cursors`:
     a history cursor per signal read through the node's history tap, else None."""

@@ -115,6 +115,7 @@ def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
     """Writes the timeline ((source time, seq, signal id, value)); returns (values written,
     lateness of each write in ns)."""
     handle, write, now = h.h, h.write, time.monotonic_ns
+    assert handle is not None, "replay needs an open handle"
     # A state is sent as its newest value: a step flushed before ccommd took the previous
     # one would replace it unsent (counted `coalesced` on this node). So each flush first
     # waits, bounded, until ccommd has taken the previous step: its `tx` counter of a

@@ -5,6 +5,9 @@
 --   tshark -X lua_script:ccomm.lua -r capture.pcap -O ccomm
 --   cp ccomm.lua ~/.local/lib/wireshark/plugins/      (Wireshark and tshark load it)
 --
+-- One file on purpose (about 600 lines): installing it is copying it, and a Lua plugin
+-- split into modules would need Wireshark's package path set up on every machine.
+--
 -- It checks every frame the way the receiver's DecodeHeader() does, in the same order,
 -- and raises one expert info per problem ("bad_entry: entry 0: unknown type 7"); the
 -- first one, which is what ccommd would count, is also the field ccomm.decode_error.

@@ -172,10 +172,12 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
     p99 = errs[int(0.99 * (len(errs) - 1))] if errs else 0
     print(f"# replay: {n} values equal and in order, {missing} missing ({tally[0]} coalesced at the producer, "
           f"{tally[1]} lost on the way); "
-          f"timing error p99 {p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance {tol_ms} ms)")
+          f"timing error p99 {p99 / 1e6:.3f} ms, max {worst / 1e6:.3f} ms (tolerance: p99 {tol_ms / 5} ms, max {tol_ms} ms)")
     if wrong:
         return 1
-    if worst > tol_ms * 1e6:
+    # The documented tolerance: p99 within a fifth of it, every value within it (a Python
+    # replayer on a general-purpose kernel: the odd wake-up is late, the bulk is not).
+    if worst > tol_ms * 1e6 or p99 > tol_ms * 1e6 / 5:
         return 4
     return 3 if missing else 0
 

@@ -16,6 +16,7 @@
 
 #include "common/platform.h"
 #include "daemon/daemon.h"
+#include "daemon/receiving_daemon_fixture.h"
 #include "testing/test_config.h"
 
 namespace ccomm {
@@ -33,40 +34,16 @@ struct FrameOpts {
   uint16_t signal = kBigId;
 };
 
-class LargeValuesTest : public ::testing::Test {
+class LargeValuesTest : public testing::ReceivingDaemonTest {
  protected:
   void SetUp() override {
-    setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("large").c_str(), 1);
     // Node a (0) is the daemon under test; b (1) produces "big" and "small".
     auto pos = testing::MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
     auto big = testing::MakeSignal("big", ValueType::kUint32, kElems, SignalKind::kState, 1, {0});
     auto small = testing::MakeSignal("small", ValueType::kUint32, 4, SignalKind::kState, 1, {0});
     auto periodic = testing::MakeSignal("bigp", ValueType::kUint32, kElems, SignalKind::kState, 1, {0});
     periodic.period_us = 10000;
-    cfg_ = testing::TwoNodeConfig({pos, big, small, periodic});
-    cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
-    cfg_.network.udp_port = testing::FreeUdpPort();
-    tx_ = socket(AF_INET, SOCK_DGRAM, 0);
-    struct sockaddr_in src = {};
-    src.sin_family = AF_INET;
-    inet_pton(AF_INET, cfg_.nodes[1].ip.c_str(), &src.sin_addr);
-    ASSERT_EQ(bind(tx_, reinterpret_cast<const sockaddr*>(&src), sizeof src), 0);
-    to_.sin_family = AF_INET;
-    to_.sin_port = htons(cfg_.network.udp_port);
-    inet_pton(AF_INET, cfg_.nodes[0].ip.c_str(), &to_.sin_addr);
-    DaemonOptions opt;
-    opt.no_realtime = true;
-    opt.recv_timeout_ms = 20;
-    std::string err;
-    ASSERT_EQ(daemon_.Start(cfg_, 0, opt, &err), 0) << err;
-    rx_ = std::thread([this] { daemon_.RunRx(); });
-  }
-  void TearDown() override {
-    daemon_.RequestStop();
-    rx_.join();
-    daemon_.Shutdown();
-    close(tx_);
-    platform::ShmUnlink(store::SegmentName("a").c_str());
+    StartDaemon("large", {pos, big, small, periodic});
   }
 
   // The fragment frames of value `value_seq` (all elements = fill), as ccommd splits it.
@@ -133,13 +110,8 @@ class LargeValuesTest : public ::testing::Test {
     return v[0];
   }
 
-  SystemConfig cfg_;
-  Daemon daemon_;
-  std::thread rx_;
-  int tx_ = -1;
   uint32_t frame_seq_ = 0;
   uint64_t sent_ = 0;
-  struct sockaddr_in to_ = {};
 };
 
 TEST_F(LargeValuesTest, LostFragmentLosesExactlyThatValue) {

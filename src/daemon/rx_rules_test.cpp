@@ -17,6 +17,7 @@
 
 #include "common/platform.h"
 #include "daemon/daemon.h"
+#include "daemon/receiving_daemon_fixture.h"
 #include "testing/test_config.h"
 
 namespace ccomm {
@@ -24,44 +25,17 @@ namespace {
 
 constexpr uint16_t kStateId = 1, kEventId = 2;
 
-class RxRulesTest : public ::testing::Test {
+class RxRulesTest : public testing::ReceivingDaemonTest {
  protected:
   void SetUp() override {
-    setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("rxrules").c_str(), 1);
     // Node a (0) is the daemon under test; b (1) produces "sp" (state) and "ev" (event).
     auto pos = testing::MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
     auto sp = testing::MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
     auto ev = testing::MakeSignal("ev", ValueType::kDouble, 1, SignalKind::kEvent, 1, {0});
     ev.queue_depth = 64;
-    cfg_ = testing::TwoNodeConfig({pos, sp, ev});
-    cfg_.nodes[0].transport = cfg_.nodes[1].transport = TransportKind::kUdp;
-    cfg_.network.udp_port = testing::FreeUdpPort();
-    tx_ = Socket(cfg_.nodes[1].ip.c_str());
-    to_.sin_family = AF_INET;
-    to_.sin_port = htons(cfg_.network.udp_port);
-    inet_pton(AF_INET, cfg_.nodes[0].ip.c_str(), &to_.sin_addr);
-    DaemonOptions opt;
-    opt.no_realtime = true;
-    opt.recv_timeout_ms = 20;
-    std::string err;
-    ASSERT_EQ(daemon_.Start(cfg_, 0, opt, &err), 0) << err;
-    rx_ = std::thread([this] { daemon_.RunRx(); });
+    StartDaemon("rxrules", {pos, sp, ev});
   }
-  void TearDown() override {
-    daemon_.RequestStop();
-    rx_.join();
-    daemon_.Shutdown();
-    close(tx_);
-    platform::ShmUnlink(store::SegmentName("a").c_str());
-  }
-  static int Socket(const char* ip) {
-    int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    struct sockaddr_in src = {};
-    src.sin_family = AF_INET;
-    inet_pton(AF_INET, ip, &src.sin_addr);
-    EXPECT_EQ(bind(fd, reinterpret_cast<const sockaddr*>(&src), sizeof src), 0);
-    return fd;
-  }
+  static int Socket(const char* ip) { return BoundSocket(ip); }
   // One frame from b with frame seq `seq` to `dest`, carrying `signal` = v with value seq
   // `value_seq` (no entry if signal is 0xFFFF: a heartbeat).
   void Send(uint32_t seq, uint16_t dest, uint16_t signal, uint32_t value_seq, double v, uint64_t send_ns = 0,
@@ -108,12 +82,7 @@ class RxRulesTest : public ::testing::Test {
     return v;
   }
 
-  SystemConfig cfg_;
-  Daemon daemon_;
-  std::thread rx_;
-  int tx_ = -1;
   uint64_t sent_ = 0;
-  struct sockaddr_in to_ = {};
 };
 
 TEST_F(RxRulesTest, StateAndFrameSequencesCrossTheWrap) {

@@ -26,27 +26,6 @@ COUNT=$((SECS * RATE))
 DAEMON_CONFIG=$WORK/bigvalue.xml
 COUNTER=$BUILD/lib/ccomm_alloc_counter.so
 
-imp_start() {
-  mkfifo "$WORK/imp.in"
-  ip netns exec "$NS_M" "$WORK/impair" --a m0 --b m1 --seed 11 <"$WORK/imp.in" >"$WORK/imp.out" 2>"$WORK/imp.err" &
-  PIDS+=($!)
-  exec 7>"$WORK/imp.in"
-  local i
-  for i in $(seq 100); do grep -q ready "$WORK/imp.out" && return 0; sleep 0.05; done
-  echo "Bail out! impair did not start: $(cat "$WORK/imp.err")"
-  exit 1
-}
-imp() {  # imp COMMAND: sends it, waits for the JSON line it prints, echoes that line
-  local n i
-  n=$(wc -l <"$WORK/imp.out")
-  echo "$*" >&7
-  for i in $(seq 200); do
-    (( $(wc -l <"$WORK/imp.out") > n )) && { tail -n1 "$WORK/imp.out"; return 0; }
-    sleep 0.01
-  done
-  echo "# impair did not answer '$*'" >&2
-  return 1
-}
 # sig NODE FIELD: a field of signal "path" from the last `stats NODE`
 sig() {
   python3 -c 'import json,sys; s=[x for x in json.load(open(sys.argv[1]))["signals"] if x["name"]=="path"][0]
@@ -56,7 +35,7 @@ jfield() { python3 -c 'import json,sys; print(json.loads(sys.argv[1])[sys.argv[2
 imp_dropped() { python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j["a2b"]["dropped"] + j["b2a"]["dropped"])' "$1"; }
 
 make_impaired_pair
-imp_start
+imp_start 11
 
 for mode in raw udp raw-multicast udp-multicast; do
   transport=${mode%%-*}

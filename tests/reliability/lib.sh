@@ -220,3 +220,27 @@ snapshot() {
 json_get() {  # json_get FILE KEY: a top-level field of the last JSON line of FILE
   python3 -c 'import json,sys; print(json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])[sys.argv[2]])' "$1" "$2"
 }
+
+# The impairment tool (impair.c, built by build_tool impair) between NS_C and NS_P in NS_M,
+# driven through a FIFO: imp_start SEED, then imp COMMAND (prints the JSON line it answers).
+imp_start() {
+  mkfifo "$WORK/imp.in"
+  ip netns exec "$NS_M" "$WORK/impair" --a m0 --b m1 --seed "$1" <"$WORK/imp.in" >"$WORK/imp.out" 2>"$WORK/imp.err" &
+  PIDS+=($!)
+  exec 7>"$WORK/imp.in"
+  local i
+  for i in $(seq 100); do grep -q ready "$WORK/imp.out" && return 0; sleep 0.05; done
+  echo "Bail out! impair did not start: $(cat "$WORK/imp.err")"
+  exit 1
+}
+imp() {  # imp COMMAND: sends it, waits for the JSON line it prints, echoes that line
+  local n i
+  n=$(wc -l <"$WORK/imp.out")
+  echo "$*" >&7
+  for i in $(seq 200); do
+    (( $(wc -l <"$WORK/imp.out") > n )) && { tail -n1 "$WORK/imp.out"; return 0; }
+    sleep 0.01
+  done
+  echo "# impair did not answer '$*'" >&2
+  return 1
+}

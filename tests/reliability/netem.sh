@@ -28,28 +28,6 @@ SECS=${NETEM_SECONDS:-3}
 SLACK=${NETEM_STALE_SLACK_MS:-15}
 SUP_SLACK=${NETEM_SUPERVISION_SLACK_MS:-100}
 
-imp_start() {
-  mkfifo "$WORK/imp.in"
-  ip netns exec "$NS_M" "$WORK/impair" --a m0 --b m1 --seed 7 <"$WORK/imp.in" >"$WORK/imp.out" 2>"$WORK/imp.err" &
-  IMP=$!
-  PIDS+=($IMP)
-  exec 7>"$WORK/imp.in"
-  local i
-  for i in $(seq 100); do grep -q ready "$WORK/imp.out" && return 0; sleep 0.05; done
-  echo "Bail out! impair did not start: $(cat "$WORK/imp.err")"
-  exit 1
-}
-imp() {  # imp COMMAND: sends it, waits for the JSON line it prints, echoes that line
-  local n i
-  n=$(wc -l <"$WORK/imp.out")
-  echo "$*" >&7
-  for i in $(seq 200); do
-    (( $(wc -l <"$WORK/imp.out") > n )) && { tail -n1 "$WORK/imp.out"; return 0; }
-    sleep 0.01
-  done
-  echo "# impair did not answer '$*'" >&2
-  return 1
-}
 SNAPS=()
 # snap NAME: clean link, let late frames land, hold everything, read both daemons.
 snap() {
@@ -223,6 +201,6 @@ sys.exit(0 if c.get("values", 0) > 100 and c.get("corrupt") is False and c.get("
 }
 
 make_impaired_pair
-imp_start
+imp_start 7
 for m in ${NETEM_MODES:-plain auth}; do run_mode "$m"; done
 finish

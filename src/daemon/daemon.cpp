@@ -40,7 +40,6 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   consumers_.assign(n, {});
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
-  rx_seq_.assign(n, SignalRx());
   collected_states_.reserve(n);  // RunTx never allocates
   last_tx_seq_.assign(n, 0);
   fresh_.assign(n, 0);

@@ -95,15 +95,21 @@ class Daemon {
   // What the receive path needs of a signal, resolved once in Start() (prepared_signals.cpp):
   // an entry whose first 8 bytes equal `prefix` and whose frame came from `producer` is
   // one this node consumes, of the right type, count and kind. prefix 0 = not consumed.
-  struct RxSignal {
+  // The fields an entry touches come first and together (one record per signal, not one
+  // array per field): the receive loop reads one or two cache lines per entry.
+  struct alignas(64) RxSignal {  // two cache lines; a power of two indexes with a shift
     uint64_t prefix = 0;
     uint32_t producer = UINT32_MAX;
+    uint32_t entry_size = 0;    // bytes of its entries on the wire (header + padded value)
     bool is_event = false;
     bool count_gaps = false;    // every value is sent (events, event-driven states)
     bool one_word = false;      // one 8-byte element (double, int64): converted inline
+    bool state_word = false;    // a one_word state: HandleFrame's inline path
+    bool history = false;       // a history ring keeps its values (AppendHistory)
+    SignalRx last;              // rule 6: its last applied value (receive thread only)
+    store::SignalStats* stats = nullptr;
     store::StateView state;
     store::RingView ring;
-    store::SignalStats* stats = nullptr;
   };
   void PrepareRxTx();           // fills rx_signals_, rx_known_, tx_prefix_, tx_state_
   void CountBadEntry(uint16_t signal, const wire::FrameHeader& h);
@@ -120,6 +126,9 @@ class Daemon {
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from);
+  __attribute__((noinline)) bool HandleOtherEntry(const wire::FrameHeader& h, const uint8_t* entry, uint64_t now);
+  bool ApplyEntry(RxSignal& rs, const uint8_t* entry, uint64_t now);
+  __attribute__((noinline)) bool StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::SlotMeta& meta);
   void HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from);
   /// Rule 5 for one accepted-so-far frame: false if it must be dropped as a duplicate.
   void AccountFrame(const wire::FrameHeader& h, uint64_t now);
@@ -143,10 +152,10 @@ class Daemon {
   /// A fragment entry: true when it completed a value that was stored.
   bool HandleFragment(const wire::FrameHeader& h, const wire::EntryRef& ref, uint64_t now);
   void ResetReassemblers(uint32_t producer);
-  /// History tap (<node history="N">): appends a stored state value to its ring, if any.
-  void AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
-    if (history_[id].ring) store::RingWrite(history_[id], value, seq, source_ns, now);
-  }
+  /// History tap (<node history="N">): appends a stored state value to its ring (the
+  /// caller checked RxSignal::history). Out of line: the common signal has none.
+  __attribute__((noinline)) void AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns,
+                                               uint64_t now);
   void Count(store::DaemonCounter c, std::memory_order order = std::memory_order_relaxed) {
     segment_.header()->daemon_counters[c].fetch_add(1, order);
   }
@@ -173,9 +182,8 @@ class Daemon {
   std::vector<uint32_t> periodic_;                // forwarded periodic signal ids
   std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
-  std::vector<SignalRx> rx_seq_;                  // signal -> last value received (rule 6)
   std::vector<RxSignal> rx_signals_;              // signal -> receive path's view of it
-  std::vector<uint64_t> rx_known_;                // signal -> wire::DecodeFrame's known entry
+  std::vector<wire::KnownEntry> rx_known_;        // signal -> wire::DecodeFrame's known entry
   std::vector<uint64_t> tx_prefix_;               // signal -> its entries' first 8 bytes
   std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
   std::vector<store::RingView> history_;          // signal -> history ring (ring null: none)

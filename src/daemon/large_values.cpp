@@ -104,7 +104,8 @@ bool Daemon::HandleFragment(const wire::FrameHeader& h, const wire::EntryRef& re
   } else {  // ccommd is the only writer of a received state (HandleFrame fences after the frame)
     store::StateWriteSingle(segment_.state(e.signal), l.reasm.value(),
                             store::SlotMeta{value_seq, l.reasm.source_time_ns(), now});
-    AppendHistory(e.signal, l.reasm.value(), value_seq, l.reasm.source_time_ns(), now);
+    if (rx_signals_[e.signal].history)
+      AppendHistory(e.signal, l.reasm.value(), value_seq, l.reasm.source_time_ns(), now);
   }
   ss.rx.fetch_add(1, std::memory_order_relaxed);
   ss.last_rx_ns.store(now, std::memory_order_relaxed);

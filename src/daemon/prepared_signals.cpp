@@ -12,7 +12,7 @@ namespace ccomm {
 void Daemon::PrepareRxTx() {
   const uint32_t n = segment_.signal_count();
   rx_signals_.assign(n, RxSignal());
-  rx_known_.assign(n, 0);
+  rx_known_.assign(n, wire::KnownEntry());
   tx_prefix_.assign(n, 0);
   tx_state_.assign(n, store::StateView());
   for (uint32_t id = 0; id < n; ++id) {
@@ -28,11 +28,14 @@ void Daemon::PrepareRxTx() {
     if (!(d.flags & store::kSigConsumedHere)) continue;
     RxSignal& r = rx_signals_[id];
     r.prefix = prefix;
-    rx_known_[id] = wire::KnownEntryPrefix(prefix, d.type, d.value_bytes);
+    rx_known_[id] = wire::MakeKnownEntry(prefix, d.type, d.value_bytes);
     r.producer = cfg_->signals[id].producer;
     r.is_event = is_event;
     r.count_gaps = is_event || cfg_->signals[id].period_us == 0;
     r.one_word = d.count == 1 && d.value_bytes == 8;
+    r.state_word = r.one_word && !is_event;
+    r.history = history_[id].ring != nullptr;
+    r.entry_size = static_cast<uint32_t>(wire::kEntryHeaderSize + ((d.value_bytes + 7u) & ~7u));
     if (is_event) r.ring = segment_.ring(id);
     else r.state = segment_.state(id);
     r.stats = &segment_.stats(id);

@@ -51,8 +51,8 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
         cfg_->nodes[h.sender].name.c_str(), h.seq, fs.expected);
     // Its value sequence numbers may restart too: rule 6 follows them (readers keep a
     // growing seq, see SignalRx).
-    for (size_t i = 0; i < rx_seq_.size(); ++i)
-      if (cfg_->signals[i].producer == h.sender) rx_seq_[i].seen = false;
+    for (size_t i = 0; i < rx_signals_.size(); ++i)
+      if (cfg_->signals[i].producer == h.sender) rx_signals_[i].last.seen = false;
     ResetReassemblers(h.sender);
     fs.last_send_ns = h.send_time_ns;
   }
@@ -62,7 +62,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
 }
 
 uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
-  SignalRx& r = rx_seq_[id];
+  SignalRx& r = rx_signals_[id].last;
   if (!r.seen) {  // first value, or after the producer restarted: numbering goes on
     r.seen = true;
     r.behind = 0;
@@ -87,6 +87,80 @@ uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
   r.behind = 0;
   r.wire = seq;
   return r.ext;
+}
+
+// An entry that is not a known one of this sender's: a part of a large value
+// (large_values.cpp), or one to count and skip. True if it completed a stored value.
+bool Daemon::HandleOtherEntry(const wire::FrameHeader& h, const uint8_t* entry, uint64_t now) {
+  const wire::EntryRef e{entry};
+  if (e.flags() & wire::kEntryFragment) return HandleFragment(h, e, now);
+  CountBadEntry(e.signal(), h);
+  return false;
+}
+
+void Daemon::AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
+  store::RingWrite(history_[id], value, seq, source_ns, now);
+}
+
+// Any other signal of a known entry: its value converted to host order, then stored.
+// False if the store refused it (an event ring full of unread values: counted).
+bool Daemon::StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::SlotMeta& meta) {
+  const wire::EntryRef e{entry};
+  const uint8_t* wire_value = entry + wire::kEntryHeaderSize;  // its prefix says: no fragment
+  const void* value = rx_value_;
+  uint64_t word;
+  if (rs.one_word) {  // one double or int64: a single byte swap
+    word = wire::be::Load<uint64_t>(wire_value);
+    value = &word;
+  } else {
+    wire::ValueToHost(e.type(), wire_value, rx_value_, e.count());
+  }
+  if (rs.is_event) {
+    if (store::RingWrite(rs.ring, value, meta.value_seq, meta.source_time_ns, meta.local_time_ns) !=
+        store::StoreResult::kOk) {
+      rs.stats->write_errors.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    return true;
+  }
+  store::StateWriteSingle(rs.state, value, meta);
+  if (rs.history) AppendHistory(e.signal(), value, meta.value_seq, meta.source_time_ns, meta.local_time_ns);
+  return true;
+}
+
+// One entry of a signal this node takes from the frame's sender (its prefix matched):
+// rule 6, then the store. Inline in HandleFrame's loops. True if a value was stored.
+__attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, const uint8_t* entry, uint64_t now) {
+  const wire::EntryRef e{entry};
+  // Rule 6; the next value in order (the common case) inline, the rest in AcceptValue.
+  // Gaps mean lost values only where every value is sent (events, event-driven states).
+  SignalRx& sr = rs.last;
+  const uint32_t seq = e.seq();
+  uint64_t value_seq;
+  if (seq == sr.wire + 1 && sr.seen) {
+    sr.wire = seq;
+    sr.behind = 0;
+    value_seq = ++sr.ext;
+  } else {
+    value_seq = AcceptValue(static_cast<uint32_t>(&rs - rx_signals_.data()), seq, rs.count_gaps);
+    if (value_seq == 0) return false;  // duplicate or older than what we have
+  }
+  const uint64_t source_ns = e.source_time_ns();
+  const uint8_t* wire_value = entry + wire::kEntryHeaderSize;  // its prefix says: no fragment
+  if (rs.state_word) {  // one double or int64 state (the common signal): inline
+    const uint64_t word = wire::be::Load<uint64_t>(wire_value);
+    store::StateWriteSingleCopies(rs.state, &word, store::SlotMeta{value_seq, source_ns, now}, 8);
+    if (rs.history) {
+      const uint64_t copy = word;  // its own address: `word` stays in a register
+      AppendHistory(e.signal(), &copy, value_seq, source_ns, now);
+    }
+  } else if (!StoreEntry(rs, entry, store::SlotMeta{value_seq, source_ns, now})) {
+    return false;
+  }
+  store::SignalStats* const stats = rs.stats;
+  stats->rx.store(stats->rx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  stats->last_rx_ns.store(now, std::memory_order_relaxed);
+  return true;
 }
 
 void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
@@ -144,56 +218,36 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
   if (h.flags & wire::kFlagHeartbeat) ps.heartbeats_rx.fetch_add(1, std::memory_order_relaxed);
 
-  // One compare per entry tells a good one (RxSignal::prefix); DecodeFrame has already
-  // checked every entry's structure, so nothing is validated twice. States go through the
-  // single-writer store (ccommd is the only writer of a received signal), counters through
-  // plain stores (this thread is their only writer): a small constant per entry.
-  wire::EntryRef e = wire::FirstEntry(buf);
+  // DecodeFrame has checked every entry's structure; the leading h.known_entries (the
+  // whole frame, usually) it matched with rx_known_, i.e. with the prefix (signal, type,
+  // flags, count, length) of a signal this node takes, so for those only the producer is
+  // left to check and the size is the signal's. The rest get one compare of their prefix.
+  // Anything else (a fragment part, another node's entry in a group frame, a bad one)
+  // takes the slow branch. Nothing is validated twice; a small constant per entry.
+  const uint8_t* p = buf + wire::kHeaderSize;
+  // Locals the compiler can keep in registers across the store's fences (h's address
+  // escaped; members may alias the shared memory the stores write).
+  RxSignal* const signals = rx_signals_.data();
+  const size_t signal_count = rx_signals_.size();
+  const uint32_t sender = h.sender, entry_count = h.entry_count, known = h.known_entries;
   bool stored = false;
-  for (uint16_t i = 0; i < h.entry_count; ++i, e = e.next()) {
-    if (e.p[3] & wire::kEntryFragment) {  // part of a large value (large_values.cpp)
-      stored |= HandleFragment(h, e, now);
-      continue;
-    }
+  uint32_t i = 0;
+  for (; i < known; ++i) {
+    RxSignal& rs = signals[wire::EntryRef{p}.signal()];  // < signal_count: rx_known_ is as long
+    if (rs.producer == sender) stored |= ApplyEntry(rs, p, now);
+    else stored |= HandleOtherEntry(h, p, now);
+    p += rs.entry_size;
+  }
+  for (; i < entry_count; ++i) {
+    const wire::EntryRef e{p};
     const uint16_t id = e.signal();
-    const RxSignal* rs = id < segment_.signal_count() ? &rx_signals_[id] : nullptr;  // sized so (PrepareRxTx)
-    if (!rs || rs->prefix != e.prefix() || rs->producer != h.sender) {
-      CountBadEntry(id, h);
-      continue;
-    }
-    // Rule 6; the next value in order (the common case) inline, the rest in AcceptValue.
-    // Gaps mean lost values only where every value is sent (events, event-driven states).
-    SignalRx& sr = rx_seq_[id];
-    const uint32_t seq = e.seq();
-    uint64_t value_seq;
-    if (sr.seen && seq == sr.wire + 1) {
-      sr.wire = seq;
-      sr.behind = 0;
-      value_seq = ++sr.ext;
+    if (id < signal_count && signals[id].prefix == e.prefix() && signals[id].producer == sender) {
+      stored |= ApplyEntry(signals[id], p, now);
+      p += signals[id].entry_size;
     } else {
-      value_seq = AcceptValue(id, seq, rs->count_gaps);
-      if (value_seq == 0) continue;  // duplicate or older than what we have
+      stored |= HandleOtherEntry(h, p, now);
+      p = e.next().p;
     }
-    const void* value = rx_value_;
-    uint64_t word;
-    if (rs->one_word) {  // one double or int64: a single byte swap
-      word = wire::be::Load<uint64_t>(e.value());
-      value = &word;
-    } else {
-      wire::ValueToHost(e.type(), e.value(), rx_value_, e.count());
-    }
-    if (rs->is_event) {
-      if (store::RingWrite(rs->ring, value, value_seq, e.source_time_ns(), now) != store::StoreResult::kOk) {
-        rs->stats->write_errors.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-    } else {
-      store::StateWriteSingle(rs->state, value, store::SlotMeta{value_seq, e.source_time_ns(), now});
-      AppendHistory(id, value, value_seq, e.source_time_ns(), now);
-    }
-    rs->stats->rx.store(rs->stats->rx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    rs->stats->last_rx_ns.store(now, std::memory_order_relaxed);
-    stored = true;
   }
   // Counted last, with release: whoever sees a frame in frames_rx (acquire) also sees
   // all its entries applied (tests and `ccomm stats` snapshots rely on that).

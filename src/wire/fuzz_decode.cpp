@@ -35,18 +35,28 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // DecodeFrame with a receiver's table of known entries must give the same verdict.
   // The table takes the prefixes found at every 8-byte position of the input (those
   // EntryPrefix accepts), so known entries, near misses and unknown ones all occur.
-  uint64_t known[64] = {};
+  KnownEntry known[64] = {};
   for (size_t off = kHeaderSize; off + 8 <= len; off += 8) {
     const uint8_t* p = data + off;
     const uint16_t signal = static_cast<uint16_t>((p[0] << 8) | p[1]);
     const uint16_t count = static_cast<uint16_t>((p[4] << 8) | p[5]);
     const uint16_t vlen = static_cast<uint16_t>((p[6] << 8) | p[7]);
-    if (signal < 64) known[signal] = KnownEntryPrefix(EntryPrefix(signal, p[2], p[3], count, vlen), p[2], vlen);
+    if (signal < 64) known[signal] = MakeKnownEntry(EntryPrefix(signal, p[2], p[3], count, vlen), p[2], vlen);
   }
   FrameHeader h2;
   Check(DecodeFrame(data, len, &h2, known, 64) == err);
   if (err != DecodeError::kOk) return 0;
   Check(h2.seq == h.seq && h2.entry_count == h.entry_count && h2.payload_len == h.payload_len);
+  // The entries it calls known are the leading ones, each with its signal's known prefix
+  // and size (a receiver applies those without looking again).
+  Check(h2.known_entries <= h2.entry_count && h.known_entries == 0);
+  {
+    EntryRef ref = FirstEntry(data);
+    for (uint16_t i = 0; i < h2.known_entries; ++i, ref = ref.next()) {
+      Check(ref.signal() < 64 && known[ref.signal()].prefix == ref.prefix() && ref.prefix() != 0);
+      Check(known[ref.signal()].size == kEntryHeaderSize + ref.value_len());
+    }
+  }
 
   const size_t tag = (h.flags & kFlagAuth) ? kAuthTagSize : 0;
   Check(len == kHeaderSize + h.payload_len + tag && len <= kMaxFrameSize);

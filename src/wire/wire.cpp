@@ -294,7 +294,8 @@ DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h) {
   return DecodeFrame(buf, len, h, nullptr, 0);
 }
 
-DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const uint64_t* known, size_t known_count) {
+DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const KnownEntry* known,
+                        size_t known_count) {
   if (buf == nullptr || len < kHeaderSize) return DecodeError::kTooShort;
   if (Load<uint32_t>(buf + kOffMagic) != kMagic) return DecodeError::kBadMagic;
   if (buf[kOffVersion] != kVersion) return DecodeError::kBadVersion;
@@ -324,21 +325,36 @@ DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const ui
     if (!SummaryBodyValid(p, payload_len)) return DecodeError::kBadSummary;
     left = 0;  // the body is the whole payload (entry_count is 0)
   }
-  for (uint16_t i = 0; i < entry_count; ++i) {
+  const uint8_t* const end = p + left;
+  uint16_t i = 0;
+  // Known entries: their first 8 bytes are ones CheckEntry accepts (EntryPrefix) with
+  // whole-word values, so only the reserved word and the bounds are left to check, and
+  // the size comes from the table. The first other entry ends this loop; the loop after
+  // it checks the rest one by one (known ones still cheaply).
+  for (; i < entry_count && end - p >= static_cast<ptrdiff_t>(kEntryHeaderSize); ++i) {
+    uint64_t prefix;
+    std::memcpy(&prefix, p, 8);
+    const uint16_t signal = Load<uint16_t>(p + kEOffSignal);
+    if (signal >= known_count) break;
+    const KnownEntry& k = known[signal];
+    // (A not-known signal's size never fits: that refuses an all-zero entry too.)
+    if (k.prefix != prefix || static_cast<size_t>(end - p) < k.size || Load<uint32_t>(p + kEOffReserved) != 0)
+      break;
+    p += k.size;
+  }
+  const uint16_t known_entries = i;
+  left = static_cast<size_t>(end - p);
+  for (; i < entry_count; ++i) {
     size_t size = 0;
     if (left >= kEntryHeaderSize) {
-      // A known entry: its first 8 bytes are ones CheckEntry accepts (EntryPrefix) with
-      // whole-word values, so only the reserved word and the bounds are left to check.
       const uint16_t signal = Load<uint16_t>(p + kEOffSignal);
       uint64_t prefix;
       std::memcpy(&prefix, p, 8);
-      if (signal < known_count && known[signal] == prefix && prefix != 0 && Load<uint32_t>(p + kEOffReserved) == 0) {
-        size = kEntryHeaderSize + Load<uint16_t>(p + kEOffLen);
-        if (size <= left) {
-          p += size;
-          left -= size;
-          continue;
-        }
+      if (signal < known_count && known[signal].prefix == prefix && prefix != 0 &&
+          Load<uint32_t>(p + kEOffReserved) == 0 && known[signal].size <= left) {
+        p += known[signal].size;
+        left -= known[signal].size;
+        continue;
       }
     }
     const DecodeError e = CheckEntry(p, left, &size);
@@ -357,6 +373,7 @@ DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const ui
   h->entry_count = entry_count;
   h->payload_len = payload_len;
   h->dest = Load<uint16_t>(buf + kOffDest);
+  h->known_entries = known_entries;
   return DecodeError::kOk;
 }
 

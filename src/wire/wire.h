@@ -54,6 +54,9 @@ struct FrameHeader {
   uint16_t entry_count = 0;
   uint16_t payload_len = 0;   // bytes of entries after the header (excludes the tag)
   uint16_t dest = 0;          // destination node id (offset 28), kDestAll = every node
+  // Not on the wire: how many leading entries DecodeFrame matched with its known table
+  // (each one's prefix is known[signal].prefix, checked with its reserved word and bounds).
+  uint16_t known_entries = 0;
 };
 constexpr uint16_t kDestAll = 0xFFFF;
 
@@ -205,17 +208,32 @@ class FrameWriter {
 /// `h` is filled and entries can be walked with EntryIterator; otherwise `h` is untouched.
 DecodeError DecodeHeader(const uint8_t* buf, size_t len, FrameHeader* h);
 
-/// DecodeHeader for a receiver that knows which entries to expect: known[signal] (for
-/// signal < known_count) is the EntryPrefix of that signal's entries if its value is whole
-/// 8-byte words of a non-bool type (value_len % 8 == 0), else 0. An entry that starts with
-/// its known prefix is checked with one compare (plus its reserved word and bounds);
-/// every other entry as DecodeHeader checks it. Same verdicts as DecodeHeader for any
-/// table built that way (fuzz_decode checks).
-DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const uint64_t* known, size_t known_count);
-/// The `known` entry of a signal for DecodeFrame: its prefix if its entries qualify, else 0.
-inline uint64_t KnownEntryPrefix(uint64_t prefix, uint8_t type, size_t value_len) {
-  return type != 1 && value_len % 8 == 0 ? prefix : 0;  // 1 = bool: its bytes need a check each
+/// What a receiver expects of one signal's entries, for DecodeFrame: their first 8 bytes
+/// (EntryPrefix) and their size on the wire. Not known (checked in full): prefix 0 and
+/// a size no entry fits in, so one bounds compare also refuses an all-zero entry.
+struct KnownEntry {
+  uint64_t prefix = 0;
+  uint32_t size = UINT32_MAX;  // kEntryHeaderSize + value_len (value_len is whole words)
+  uint32_t unused = 0;
+};
+/// The KnownEntry of a signal whose entries start with `prefix` (EntryPrefix): known if
+/// its value is whole 8-byte words of a non-bool type (value_len % 8 == 0), else not.
+inline KnownEntry MakeKnownEntry(uint64_t prefix, uint8_t type, size_t value_len) {
+  KnownEntry k;
+  if (prefix != 0 && type != 1 && value_len % 8 == 0) {  // 1 = bool: its bytes need a check each
+    k.prefix = prefix;
+    k.size = static_cast<uint32_t>(kEntryHeaderSize + value_len);
+  }
+  return k;
 }
+
+/// DecodeHeader for a receiver that knows which entries to expect: known[signal] (for
+/// signal < known_count) made by MakeKnownEntry. An entry that starts with its known
+/// prefix is checked with one compare (plus its reserved word and bounds); every other
+/// entry as DecodeHeader checks it. Same verdicts as DecodeHeader for any table built
+/// that way (fuzz_decode checks).
+DecodeError DecodeFrame(const uint8_t* buf, size_t len, FrameHeader* h, const KnownEntry* known,
+                        size_t known_count);
 
 /// Ethernet pads payloads shorter than this with zero bytes (a plain heartbeat is 32).
 constexpr size_t kEthMinPayload = 46;

@@ -40,6 +40,7 @@ struct HandleSignal {
   uint32_t value_bytes = 0;
   uint32_t count = 0;
   uint8_t type = 0;
+  uint8_t read8_type = 0;    // `type` if a state of one 8-byte value (ReadState8), else 0
   uint64_t stale_ns = 0;     // 0 = never stale
   st::SignalStats* stats = nullptr;
   const uint8_t* safe_value = nullptr;
@@ -108,19 +109,25 @@ inline void CopyValue(void* dst, const void* src, uint32_t n) {
   else memcpy(dst, src, n);
 }
 
-__attribute__((always_inline)) inline StoreResult ReadState(HandleSignal& h, void* value, SlotMeta* meta) {
+// The cache's value and meta are the read's result: a new value is copied from the cell
+// into the cache once (the stamp taken before it, its inline word being the copy's
+// first look: StateReadStamped), and either way the caller takes meta from the cache.
+// A failed copy leaves no stamp, so the cache is never taken for a damaged copy.
+__attribute__((always_inline)) inline StoreResult ReadState(HandleSignal& h, void* value, const SlotMeta** meta) {
   StateCache& k = h.cache;
   const st::StateStamp stamp = st::StateStampOf(h.state);
+  *meta = &k.meta;
   if (stamp.version && stamp == k.stamp) {
     CopyValue(value, k.value, h.value_bytes);
-    *meta = k.meta;
     return StoreResult::kOk;
   }
-  StoreResult r = st::StateRead(h.state, value, meta);
+  const StoreResult r = h.value_bytes == 8 ? st::StateReadStamped(h.state, stamp, k.value, &k.meta, 8)
+                                           : st::StateReadStamped(h.state, stamp, k.value, &k.meta, h.value_bytes);
   if (r == StoreResult::kOk) {
-    CopyValue(k.value, value, h.value_bytes);
-    k.meta = *meta;
     k.stamp = stamp;
+    CopyValue(value, k.value, h.value_bytes);
+  } else {
+    k.stamp.version = 0;  // the cache may hold part of a refused copy
   }
   return r;
 }
@@ -240,6 +247,7 @@ int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
       ccomm::store::RingSubscribe(h.ring, &h.cursor);
     } else {
       h.state = c->segment.state(i);
+      if (d.count == 1 && d.value_bytes == 8) h.read8_type = d.type;
     }
     if (size_t k = CachedBytes(d)) {
       h.cache.value = c->cache_bytes + off;
@@ -313,6 +321,90 @@ int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out
 
 namespace {
 
+// The status and ccomm_info of a state read that ended with r (meta: the value's, if kOk).
+__attribute__((always_inline)) inline int FinishState(HandleSignal* h, void* value, ccomm_info* info, StoreResult r,
+                                                      const SlotMeta& meta, uint64_t now) {
+  if (r == StoreResult::kBusy) return CCOMM_E_BUSY;
+  if (r == StoreResult::kCorrupt) {
+    h->stats->corrupt.fetch_add(1, std::memory_order_relaxed);
+    return CCOMM_E_CORRUPT;
+  }
+  int status;
+  int64_t age = -1;
+  if (r == StoreResult::kNever) {
+    status = CCOMM_NEVER;
+  } else {
+    age = Age(now, meta.local_time_ns);
+    status = (h->stale_ns && static_cast<uint64_t>(age) > h->stale_ns) ? CCOMM_STALE : CCOMM_FRESH;
+  }
+  uint32_t flags = 0;
+  if (status != CCOMM_FRESH && h->safe_value) {
+    memcpy(value, h->safe_value, h->value_bytes);
+    flags |= CCOMM_INFO_SAFE_VALUE;
+  }
+  if (info) {
+    info->status = status;
+    info->flags = flags;
+    info->seq = r == StoreResult::kOk ? meta.value_seq : 0;
+    info->age_ns = age;
+    info->source_time_ns = r == StoreResult::kOk ? meta.source_time_ns : 0;
+    info->lost = h->stats->lost.load(std::memory_order_relaxed);
+  }
+  return status;
+}
+
+// ReadState8's rare cases, as tail calls out of its line (so that its common path keeps
+// nothing across a call): the inline copy was not usable or moved (StateRead from the
+// start), or a read that found no fresh value.
+__attribute__((noinline)) int FinishStateSlow(HandleSignal* h, void* value, ccomm_info* info, StoreResult r,
+                                              uint64_t now) {
+  return FinishState(h, value, info, r, h->cache.meta, now);
+}
+__attribute__((noinline)) int ReadState8Slow(ccomm_client* c, HandleSignal* h, void* value, ccomm_info* info,
+                                             st::StateStamp stamp) {
+  StateCache& k = h->cache;
+  const StoreResult r = st::StateReadCopies(h->state, k.value, &k.meta, 8);
+  k.stamp = stamp;
+  if (r != StoreResult::kOk) k.stamp.version = 0;  // the cache may hold part of a refused copy
+  else memcpy(value, k.value, 8);
+  return FinishState(h, value, info, r, k.meta, Now(c));
+}
+
+// ccomm_read of a state holding one 8-byte value (double, int64: h->read8_type), the
+// control loop's read: ReadState and FinishState with the size known, the cell's two
+// words compared with the cache and, when they moved, the inline copy read from the
+// words just loaded; the rest out of line.
+__attribute__((always_inline)) inline int ReadState8(ccomm_client* c, HandleSignal* h, void* value,
+                                                     ccomm_info* info) {
+  if (Retired(c)) return CCOMM_E_RETIRED;
+  StateCache& k = h->cache;
+  const st::StateView v = h->state;  // the cell's address once, not again after each acquire load
+  const st::StateStamp stamp = st::StateStampOf(v, 8);
+  if (!(stamp.version && stamp == k.stamp)) {
+    const st::CopyResult cr = st::StateReadInlineStamped(v, stamp, k.value, &k.meta, 8);
+    if (__builtin_expect(cr != st::CopyResult::kOk, 0)) {
+      if (cr != st::CopyResult::kCorrupt) return ReadState8Slow(c, h, value, info, stamp);
+      k.stamp.version = 0;  // the cache holds part of a refused copy
+      return FinishStateSlow(h, value, info, StoreResult::kCorrupt, 0);
+    }
+    k.stamp = stamp;
+  }
+  memcpy(value, k.value, 8);
+  const uint64_t now = Now(c);
+  const int64_t age = Age(now, k.meta.local_time_ns);
+  if (__builtin_expect(h->stale_ns != 0 && static_cast<uint64_t>(age) > h->stale_ns, 0))
+    return FinishStateSlow(h, value, info, StoreResult::kOk, now);
+  if (info) {
+    info->status = CCOMM_FRESH;
+    info->flags = 0;
+    info->seq = k.meta.value_seq;
+    info->age_ns = age;
+    info->source_time_ns = k.meta.source_time_ns;
+    info->lost = h->stats->lost.load(std::memory_order_relaxed);
+  }
+  return CCOMM_FRESH;
+}
+
 // ccomm_read after its argument checks; the typed reads call it directly (no second
 // check, no call through the PLT).
 __attribute__((always_inline)) inline int ReadSignal(ccomm_client* c, HandleSignal* h, void* value,
@@ -349,34 +441,14 @@ __attribute__((always_inline)) inline int ReadSignal(ccomm_client* c, HandleSign
     return CCOMM_FRESH;
   }
 
-  StoreResult r = ReadState(*h, value, &meta);
-  if (r == StoreResult::kBusy) return CCOMM_E_BUSY;
-  if (r == StoreResult::kCorrupt) {
-    h->stats->corrupt.fetch_add(1, std::memory_order_relaxed);
-    return CCOMM_E_CORRUPT;
-  }
-  int status;
-  int64_t age = -1;
-  if (r == StoreResult::kNever) {
-    status = CCOMM_NEVER;
-  } else {
-    age = Age(now, meta.local_time_ns);
-    status = (h->stale_ns && static_cast<uint64_t>(age) > h->stale_ns) ? CCOMM_STALE : CCOMM_FRESH;
-  }
-  uint32_t flags = 0;
-  if (status != CCOMM_FRESH && h->safe_value) {
-    memcpy(value, h->safe_value, h->value_bytes);
-    flags |= CCOMM_INFO_SAFE_VALUE;
-  }
-  if (info) {
-    info->status = status;
-    info->flags = flags;
-    info->seq = r == StoreResult::kOk ? meta.value_seq : 0;
-    info->age_ns = age;
-    info->source_time_ns = r == StoreResult::kOk ? meta.source_time_ns : 0;
-    info->lost = h->stats->lost.load(std::memory_order_relaxed);
-  }
-  return status;
+  const SlotMeta* m = nullptr;
+  const StoreResult r = ReadState(*h, value, &m);
+  return FinishState(h, value, info, r, *m, now);
+}
+
+// ReadSignal as a call: the 8-byte typed reads keep their ReadState8 line free of it.
+__attribute__((noinline)) int ReadSignalOutOfLine(ccomm_client* c, HandleSignal* h, void* value, ccomm_info* info) {
+  return ReadSignal(c, h, value, info);
 }
 
 }  // namespace
@@ -444,9 +516,12 @@ int ccomm_write(ccomm_client* c, ccomm_signal s, const void* value, size_t len) 
 
 #define CCOMM_TYPED(suffix, ctype, code)                                                     \
   int ccomm_read_##suffix(ccomm_client* c, ccomm_signal s, ctype* v, ccomm_info* info) {     \
-    HandleSignal* h = Sig(c, s);                                                             \
-    if (!h || !v) return CCOMM_E_INVAL;                                                      \
+    /* Sig(), with one compare for a negative or too large s */                              \
+    if (!c || static_cast<uint32_t>(s) >= c->signal_count || !v) return CCOMM_E_INVAL;       \
+    HandleSignal* h = &c->sig[s];                                                            \
+    if (sizeof(ctype) == 8 && h->read8_type == (code)) return ReadState8(c, h, v, info);     \
     if (h->type != (code) || h->count != 1) return CCOMM_E_TYPE;                             \
+    if (sizeof(ctype) == 8) return ReadSignalOutOfLine(c, h, v, info);                       \
     return ReadSignal(c, h, v, info);                                                        \
   }                                                                                          \
   int ccomm_write_##suffix(ccomm_client* c, ccomm_signal s, ctype v) {                       \

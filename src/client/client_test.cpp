@@ -121,6 +121,63 @@ TEST_F(ClientTest, StateReadsSayFreshStaleNeverWithSafeValue) {
   ccomm_close(b);
 }
 
+// ccomm_read_double's cache (ReadState8): an unchanged cell is answered from the handle's
+// last copy; a new value is taken from the inline copy, or from the slot when the inline
+// copy is being rewritten; a damaged copy is refused, counted, never returned, and is not
+// kept as the cached value (the next read checks the cell again).
+TEST_F(ClientTest, DoubleReadCacheFollowsTheCellAndRefusesDamage) {
+  ccomm_client* a = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &a), 0);
+  const ccomm_signal sp = ccomm_find(a, "pos");  // never stale
+  ASSERT_EQ(sp, 0);
+  const store::StateView sv = seg_a_.state(0);
+  store::SignalStats& stats = seg_a_.stats(0);
+  const uint64_t corrupt0 = stats.corrupt.load();
+  double in = 1.5, v = 0;
+  ccomm_info info;
+  const uint64_t now = platform::MonotonicNs();
+  ASSERT_EQ(store::StateWrite(sv, &in, 10, 1, now), store::StoreResult::kOk);
+  ASSERT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);
+  EXPECT_EQ(v, 1.5);
+  EXPECT_EQ(info.seq, 10u);
+  v = 0;
+  ASSERT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);  // unchanged: the cached copy
+  EXPECT_EQ(v, 1.5);
+  EXPECT_EQ(info.seq, 10u);
+  EXPECT_EQ(info.source_time_ns, 1u);
+
+  // A stray write into the inline copy's value, its sequence word left plausible.
+  in = 2.5;
+  ASSERT_EQ(store::StateWrite(sv, &in, 11, 2, now), store::StoreResult::kOk);
+  sv.cell->inline_value[0].fetch_xor(1);
+  v = 0;
+  EXPECT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_E_CORRUPT);
+  EXPECT_EQ(v, 0.0);  // nothing of the damaged copy returned
+  EXPECT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_E_CORRUPT);  // not cached
+  EXPECT_EQ(v, 0.0);
+  EXPECT_EQ(stats.corrupt.load(), corrupt0 + 2);
+
+  // The next value heals it; then the inline copy is marked as being rewritten: the read
+  // falls back to the slot of `latest`.
+  in = 3.5;
+  ASSERT_EQ(store::StateWrite(sv, &in, 12, 3, now), store::StoreResult::kOk);
+  ASSERT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);
+  EXPECT_EQ(v, 3.5);
+  EXPECT_EQ(info.seq, 12u);
+  in = 4.5;
+  ASSERT_EQ(store::StateWrite(sv, &in, 13, 4, now), store::StoreResult::kOk);
+  sv.cell->inline_seq.fetch_or(1);
+  ASSERT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);
+  EXPECT_EQ(v, 4.5);
+  EXPECT_EQ(info.seq, 13u);
+  EXPECT_EQ(info.source_time_ns, 4u);
+  v = 0;
+  ASSERT_EQ(ccomm_read_double(a, sp, &v, &info), CCOMM_FRESH);  // cached from the slot read
+  EXPECT_EQ(v, 4.5);
+  EXPECT_EQ(stats.corrupt.load(), corrupt0 + 2);
+  ccomm_close(a);
+}
+
 TEST_F(ClientTest, TwoAppsOnOneNodeThroughSharedMemory) {
   ccomm::Client writer("a"), reader("a");
   ASSERT_TRUE(writer.ok());

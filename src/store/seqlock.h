@@ -101,13 +101,12 @@ inline void StampAndPublish(std::atomic<uint64_t>* seq, std::atomic<uint64_t>* m
   StampCheckedAndPublish(seq, meta4, data, t, value_bytes, value, meta, CopyCheck(meta, value, value_bytes));
 }
 
-/// Copies a seqlocked value if it holds complete ticket t: kChanged if not (yet) or if
-/// it changed while being copied, kCorrupt if it stayed put but fails its check.
-__attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq,
-                                                         const std::atomic<uint64_t>* meta4, const uint8_t* data,
-                                                         uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
-  uint64_t s1 = seq->load(std::memory_order_acquire);
-  if (s1 != 2 * t + 2) return CopyResult::kChanged;
+/// The rest of ReadCopy, for a reader that already loaded (with acquire order) the
+/// sequence word s1, even and the ticket it wants: the stamp a cached reader compares
+/// is that same word, so a new value costs no second look before the copy.
+__attribute__((always_inline)) inline CopyResult ReadCopyAt(const std::atomic<uint64_t>* seq, uint64_t s1,
+                                                           const std::atomic<uint64_t>* meta4, const uint8_t* data,
+                                                           uint32_t value_bytes, void* out, SlotMeta* meta) {
   meta->value_seq = meta4[0].load(kMetaLoad);
   meta->source_time_ns = meta4[1].load(kMetaLoad);
   meta->local_time_ns = meta4[2].load(kMetaLoad);
@@ -116,6 +115,16 @@ __attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint
   SeqlockReaderFence();
   if (seq->load(std::memory_order_relaxed) != s1) return CopyResult::kChanged;
   return check == CopyCheck(*meta, out, value_bytes) ? CopyResult::kOk : CopyResult::kCorrupt;
+}
+
+/// Copies a seqlocked value if it holds complete ticket t: kChanged if not (yet) or if
+/// it changed while being copied, kCorrupt if it stayed put but fails its check.
+__attribute__((always_inline)) inline CopyResult ReadCopy(const std::atomic<uint64_t>* seq,
+                                                         const std::atomic<uint64_t>* meta4, const uint8_t* data,
+                                                         uint64_t t, uint32_t value_bytes, void* out, SlotMeta* meta) {
+  uint64_t s1 = seq->load(std::memory_order_acquire);
+  if (s1 != 2 * t + 2) return CopyResult::kChanged;
+  return ReadCopyAt(seq, s1, meta4, data, value_bytes, out, meta);
 }
 
 /// A slot's copy (the value follows its header).

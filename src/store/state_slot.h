@@ -207,11 +207,36 @@ struct StateStamp {
   uint64_t inline_seq = 0;
   bool operator==(const StateStamp& o) const { return version == o.version && inline_seq == o.inline_seq; }
 };
-inline StateStamp StateStampOf(const StateView& v) {
+inline StateStamp StateStampOf(const StateView& v, uint32_t value_bytes) {
   StateStamp s;
   s.version = v.cell->latest.load(std::memory_order_acquire);
-  s.inline_seq = v.value_bytes <= kInlineValueBytes ? v.cell->inline_seq.load(std::memory_order_acquire) : 0;
+  s.inline_seq = value_bytes <= kInlineValueBytes ? v.cell->inline_seq.load(std::memory_order_acquire) : 0;
   return s;
+}
+inline StateStamp StateStampOf(const StateView& v) { return StateStampOf(v, v.value_bytes); }
+
+/// The inline copy's read for a reader that took `s` = StateStampOf(v) just before (a
+/// cached reader comparing it with its last copy's): the stamp's inline sequence word is
+/// the copy's first look, so a new small value costs no second load of either word.
+/// kChanged: that copy is not usable (being rewritten, older than `latest`, a large
+/// value, or it moved): StateRead then.
+__attribute__((always_inline)) inline CopyResult StateReadInlineStamped(const StateView& v, const StateStamp& s,
+                                                                        void* out, SlotMeta* meta,
+                                                                        uint32_t value_bytes) {
+  // Same test as StateReadCopies (t = version - 1: complete, not older than `latest`).
+  if (value_bytes > kInlineValueBytes || s.version == 0 || (s.inline_seq & 1) || s.inline_seq < 2 * s.version)
+    return CopyResult::kChanged;
+  return ReadCopyAt(&v.cell->inline_seq, s.inline_seq, v.cell->inline_meta,
+                    reinterpret_cast<const uint8_t*>(v.cell->inline_value), value_bytes, out, meta);
+}
+
+/// StateRead after StateStampOf (see StateReadInlineStamped).
+__attribute__((always_inline)) inline StoreResult StateReadStamped(const StateView& v, const StateStamp& s,
+                                                                   void* out, SlotMeta* meta, uint32_t value_bytes) {
+  const CopyResult r = StateReadInlineStamped(v, s, out, meta, value_bytes);
+  if (r == CopyResult::kOk) return StoreResult::kOk;
+  if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
+  return StateReadCopies(v, out, meta, value_bytes);
 }
 
 /// Change counter for ccomm_wait(): seq_cst, ordered with SegmentHeader::rx_waiters.

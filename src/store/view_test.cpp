@@ -103,8 +103,11 @@ TEST(View, SeqlockGivesConsistentCopies) {
     }
   });
   uint64_t last = 0, copies = 0, mixed = 0;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
-  while (std::chrono::steady_clock::now() < until) {
+  // At least 300 ms, and on until some copies got through (a loaded 2-CPU machine can
+  // starve the reader for a while: the test is about mixtures, not speed), at most 10 s.
+  const auto start = std::chrono::steady_clock::now();
+  const auto until = start + std::chrono::milliseconds(300), give_up = start + std::chrono::seconds(10);
+  for (auto now = start; now < until || (copies < 100 && now < give_up); now = std::chrono::steady_clock::now()) {
     ViewNodeCopy n;
     if (r.ReadNode(1, &n)) {
       ++copies;

@@ -133,7 +133,7 @@ static_assert(sizeof(SlotHeader) == 48, "slot header is 6 words");
 // Values of at most this many bytes also live in the cell's first cache line (below).
 constexpr uint32_t kInlineValueBytes = 16;
 
-// A state cell: two cache lines, then kStateSlots slots (state_slot.h).
+// A state cell: three cache lines, then kStateSlots slots (state_slot.h).
 // Line 0 is all a reader touches for a small value: `latest` and a copy of the newest
 // value under its own seqlock (`inline_seq`), so a hand-off moves one cache line, as a
 // bare shared variable does. Writers change line 0 only with plain stores and the one
@@ -146,8 +146,10 @@ struct alignas(kCacheLine) StateCell {
   std::atomic<uint64_t> inline_meta[4];  // value_seq, source_time_ns, local_time_ns, check (as SlotHeader)
   std::atomic<uint64_t> inline_value[kInlineValueBytes / 8];
   alignas(kCacheLine) std::atomic<uint64_t> next_ticket;  // claimed tickets
-  std::atomic<uint64_t> forwarded;    // `latest` value ccommd last sent (send-side bookkeeping)
   SlotHeader inline_claim;            // seq/owner only: the writer filling the inline copy
+  // ccommd's send side alone, on a line of its own: beside the writers' line it moved
+  // that line between the application's core and ccommd's with every value.
+  alignas(kCacheLine) std::atomic<uint64_t> forwarded;  // `latest` value ccommd last sent
   // followed (at the next cache line) by kStateSlots slots of slot_bytes each
 };
 static_assert(offsetof(StateCell, next_ticket) == kCacheLine, "a reader's part of a cell is one line");

@@ -42,7 +42,6 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   fwd_cursors_.assign(n, store::RingCursor());
   rx_seq_.assign(n, SignalRx());
   collected_states_.reserve(n);  // RunTx never allocates
-  last_tx_seq_.assign(n, 0);
   fresh_.assign(n, 0);
   TransportKind kind = opt.force_udp ? TransportKind::kUdp : self.transport;
   for (size_t i = 0; i < n; ++i) {

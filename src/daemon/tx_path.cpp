@@ -71,7 +71,50 @@ __attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const s
   tx.store(tx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
 
+// The common case (TxSignal::fast: a state, one int64/double, one stream) in a small
+// function of its own, so that it saves and restores few registers; every rarer case
+// (no frame open or full, a damaged copy, values to catch up) calls out of line.
 void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
+  TxSignal& s = tx_signals_[id];
+  if (!s.fast) return CollectSignalSlow(id, now, periodic);
+  const uint64_t version = store::StateVersion(s.state);
+  // Event-driven: send each new value once. Periodic: send the last value every period.
+  if (version == 0 || (!periodic && version == store::StateForwarded(s.state))) return;
+  store::SlotMeta m;
+  uint64_t word;
+  const store::StoreResult r = store::StateReadCopies(s.state, &word, &m, 8);  // verifies the copy's check
+  if (__builtin_expect(r != store::StoreResult::kOk, 0)) return TxReadFailed(id, r);  // never forwarded
+  store::MarkStateForwarded(s.state, version);
+  if (!periodic) {
+    collected_states_.push_back(id);  // preallocated: at most one per signal
+    if (__builtin_expect((s.last_seq || !adopted_) && m.value_seq > s.last_seq + 1, 0))  // see CollectSignalSlow
+      CatchUpAndCount(id, s.last_seq, m.value_seq, now);
+  }
+  s.last_seq = m.value_seq;
+  PeerTx& p = peers_tx_[s.peer];
+  if (__builtin_expect(p.open && p.writer.AddWord(s.prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, word), 1)) {
+    s.tx->store(s.tx->load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // its only writer
+    return;
+  }
+  AddEntryOutOfLine(id, m, &word, now);  // no frame open, or it is full (counts tx)
+}
+
+__attribute__((noinline, cold)) void Daemon::TxReadFailed(uint32_t id, store::StoreResult r) {
+  if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
+}
+
+__attribute__((noinline)) void Daemon::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
+                                                       uint64_t now) {
+  const uint64_t gone = CatchUp(id, segment_.dir(id), last_sent, newest, now);
+  if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
+}
+
+__attribute__((noinline)) void Daemon::AddEntryOutOfLine(uint32_t id, const store::SlotMeta& m, const void* value,
+                                                         uint64_t now) {
+  AddEntry(id, segment_.dir(id), 0, m, value, now);
+}
+
+void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   if (large_[id] && !sending_large_) {  // sent after the round's small entries
     large_pending_.push_back({id, periodic});
     return;
@@ -102,7 +145,7 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
   if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
-  uint64_t& last = last_tx_seq_[id];
+  uint64_t& last = tx_signals_[id].last_seq;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
   if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {
@@ -159,7 +202,7 @@ void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
       store::SlotMeta m;
       if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) continue;
       store::MarkStateForwarded(sv, version);
-      uint64_t& last = last_tx_seq_[id];
+      uint64_t& last = tx_signals_[id].last_seq;
       if (m.value_seq <= last) continue;
       // The newer step's values follow the ones already in the frame (and any between,
       // from the slots): each step leaves whole, in order, and nothing is replaced.

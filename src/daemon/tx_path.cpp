@@ -77,26 +77,30 @@ __attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const s
 void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   TxSignal& s = tx_signals_[id];
   if (!s.fast) return CollectSignalSlow(id, now, periodic);
-  const uint64_t version = store::StateVersion(s.state);
+  // A local copy: the acquire loads below would make the compiler reload it from `s`.
+  const store::StateView sv = s.state;
+  const uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
-  if (version == 0 || (!periodic && version == store::StateForwarded(s.state))) return;
+  if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
+  // m and word never leave this function by address: they stay in registers.
   store::SlotMeta m;
   uint64_t word;
-  const store::StoreResult r = store::StateReadCopies(s.state, &word, &m, 8);  // verifies the copy's check
+  const store::StoreResult r = store::StateReadCopies(sv, &word, &m, 8);  // verifies the copy's check
   if (__builtin_expect(r != store::StoreResult::kOk, 0)) return TxReadFailed(id, r);  // never forwarded
-  store::MarkStateForwarded(s.state, version);
+  store::MarkStateForwarded(sv, version);
   if (!periodic) {
-    collected_states_.push_back(id);  // preallocated: at most one per signal
-    if (__builtin_expect((s.last_seq || !adopted_) && m.value_seq > s.last_seq + 1, 0))  // see CollectSignalSlow
-      CatchUpAndCount(id, s.last_seq, m.value_seq, now);
+    collected_states_[collected_count_++] = id;  // at most once per signal and round
+    const uint64_t last = s.last_seq;
+    if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0))  // as in CollectSignalSlow
+      CatchUpAndCount(id, last, m.value_seq, now);
   }
   s.last_seq = m.value_seq;
-  PeerTx& p = peers_tx_[s.peer];
+  PeerTx& p = *s.peer;
   if (__builtin_expect(p.open && p.writer.AddWord(s.prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, word), 1)) {
     s.tx->store(s.tx->load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // its only writer
     return;
   }
-  AddEntryOutOfLine(id, m, &word, now);  // no frame open, or it is full (counts tx)
+  AddEntryOutOfLine(id, m.value_seq, m.source_time_ns, word, now);  // no frame open, or it is full (counts tx)
 }
 
 __attribute__((noinline, cold)) void Daemon::TxReadFailed(uint32_t id, store::StoreResult r) {
@@ -109,9 +113,12 @@ __attribute__((noinline)) void Daemon::CatchUpAndCount(uint32_t id, uint64_t las
   if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
 }
 
-__attribute__((noinline)) void Daemon::AddEntryOutOfLine(uint32_t id, const store::SlotMeta& m, const void* value,
-                                                         uint64_t now) {
-  AddEntry(id, segment_.dir(id), 0, m, value, now);
+__attribute__((noinline)) void Daemon::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
+                                                         uint64_t word, uint64_t now) {
+  store::SlotMeta m;  // AddEntry uses these two of it
+  m.value_seq = value_seq;
+  m.source_time_ns = source_time_ns;
+  AddEntry(id, segment_.dir(id), 0, m, &word, now);
 }
 
 void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
@@ -144,7 +151,7 @@ void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
-  if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
+  if (!periodic) collected_states_[collected_count_++] = id;  // at most once per signal and round
   uint64_t& last = tx_signals_[id].last_seq;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
@@ -195,7 +202,8 @@ void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
     const uint32_t steps_now = h->steps_done.load(std::memory_order_acquire);
     if (steps_now == steps_before) return;
     steps_before = steps_now;
-    for (uint32_t id : collected_states_) {
+    for (uint32_t i = 0; i < collected_count_; ++i) {
+      const uint32_t id = collected_states_[i];
       const store::StateView& sv = tx_state_[id];
       const uint64_t version = store::StateVersion(sv);
       if (version == store::StateForwarded(sv)) continue;  // unchanged since it was taken
@@ -227,7 +235,7 @@ void Daemon::RunTx() {
     uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
     uint64_t now = platform::MonotonicNs();
     const uint32_t steps_before = h->steps_done.load(std::memory_order_acquire);
-    collected_states_.clear();
+    collected_count_ = 0;
     for (uint32_t w = 0; w < words; ++w) {
       uint64_t bits = dirty[w].exchange(0, std::memory_order_acq_rel);
       while (bits) {

@@ -29,8 +29,8 @@ void Daemon::PrepareRxTx() {
       t.state = tx_state_[id];
       t.prefix = prefix;
       t.tx = &segment_.stats(id).tx;
-      t.fast = !is_event && d.value_bytes == 8 && wire::FrameWriter::IsWordPrefix(prefix) && consumers_[id].size() == 1 &&
-               !large_[id];
+      t.fast = !is_event && d.value_bytes == 8 && wire::FrameWriter::IsWordPrefix(prefix) &&
+               consumers_[id].size() == 1 && !large_[id];
       if (t.fast) t.peer = &peers_tx_[consumers_[id][0]];
     }
     if (!(d.flags & store::kSigConsumedHere)) continue;

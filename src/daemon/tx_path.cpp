@@ -96,7 +96,8 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   }
   s.last_seq = m.value_seq;
   PeerTx& p = *s.peer;
-  if (__builtin_expect(p.open && p.writer.AddWord(s.prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, word), 1)) {
+  const uint32_t seq = static_cast<uint32_t>(m.value_seq);
+  if (__builtin_expect(p.open && p.writer.AddWord(s.prefix, seq, m.source_time_ns, word), 1)) {
     s.tx->store(s.tx->load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // its only writer
     return;
   }

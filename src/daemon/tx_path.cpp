@@ -81,7 +81,8 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   const store::StateView sv = s.state;
   const uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
-  if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
+  // (No test of version 0 here: `forwarded` is then 0 too, or the read below finds kNever.)
+  if (!periodic && version == store::StateForwarded(sv)) return;
   // m and word never leave this function by address: they stay in registers.
   store::SlotMeta m;
   uint64_t word;

@@ -40,8 +40,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   consumers_.assign(n, {});
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
-  collected_states_.reserve(n);  // RunTx never allocates
-  last_tx_seq_.assign(n, 0);
+  collected_states_.assign(n, 0);  // RunTx never allocates: a state is taken at most once a round
   fresh_.assign(n, 0);
   TransportKind kind = opt.force_udp ? TransportKind::kUdp : self.transport;
   for (size_t i = 0; i < n; ++i) {

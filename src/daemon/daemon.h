@@ -111,10 +111,14 @@ class Daemon {
     store::StateView state;
     store::RingView ring;
   };
-  void PrepareRxTx();           // fills rx_signals_, rx_known_, tx_prefix_, tx_state_
+  void PrepareRxTx();           // fills rx_signals_, rx_known_, tx_prefix_, tx_state_, tx_signals_
   void CountBadEntry(uint16_t signal, const wire::FrameHeader& h);
 
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
+  void CollectSignalSlow(uint32_t id, uint64_t now, bool periodic);  // all but TxSignal::fast
+  void TxReadFailed(uint32_t id, store::StoreResult r);
+  void CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest, uint64_t now);
+  void AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns, uint64_t word, uint64_t now);
   void SettleSteps(uint32_t steps_before, uint64_t now);
   /// Adds the values of state `id` written after `last_sent` and before the newest one
   /// (value_seq `newest`) that its slots still hold, oldest first; returns how many of
@@ -186,9 +190,21 @@ class Daemon {
   std::vector<wire::KnownEntry> rx_known_;        // signal -> wire::DecodeFrame's known entry
   std::vector<uint64_t> tx_prefix_;               // signal -> its entries' first 8 bytes
   std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
+  // What the send path needs of a signal in one record (one index, one cache line); `fast`:
+  // the common case, a forwarded state with one int64/double value going out on one
+  // stream (a peer or the group), not in fragments.
+  struct alignas(64) TxSignal {
+    store::StateView state;
+    uint64_t prefix = 0;                         // its entries' first 8 bytes
+    std::atomic<uint64_t>* tx = nullptr;         // its `tx` counter (this thread: only writer)
+    uint64_t last_seq = 0;                       // last value_seq sent (any path)
+    PeerTx* peer = nullptr;                      // fast: the one stream (peers_tx_ is never resized)
+    bool fast = false;                           // the case above: CollectSignal's fast path
+  };
+  std::vector<TxSignal> tx_signals_;              // signal -> its send record
   std::vector<store::RingView> history_;          // signal -> history ring (ring null: none)
-  std::vector<uint32_t> collected_states_;        // state signals taken this send round
-  std::vector<uint64_t> last_tx_seq_;             // signal -> last value_seq sent
+  std::vector<uint32_t> collected_states_;        // state signals taken this send round: [0, collected_count_)
+  uint32_t collected_count_ = 0;
   std::vector<uint8_t> fresh_;                    // signal -> was fresh at last tick
   std::vector<uint32_t> consumed_;                // ids of signals consumed here
   std::vector<store::SlotSuspect> reclaim_suspects_;  // slot -> what the last scan saw

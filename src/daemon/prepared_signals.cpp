@@ -15,6 +15,7 @@ void Daemon::PrepareRxTx() {
   rx_known_.assign(n, wire::KnownEntry());
   tx_prefix_.assign(n, 0);
   tx_state_.assign(n, store::StateView());
+  tx_signals_.assign(n, TxSignal());
   for (uint32_t id = 0; id < n; ++id) {
     const store::SignalDirectoryEntry& d = segment_.dir(id);
     const bool is_event = (d.flags & store::kSigEvent) != 0;
@@ -24,6 +25,13 @@ void Daemon::PrepareRxTx() {
     if (d.flags & store::kSigForwarded) {
       tx_prefix_[id] = prefix;
       if (!is_event) tx_state_[id] = segment_.state(id);
+      TxSignal& t = tx_signals_[id];
+      t.state = tx_state_[id];
+      t.prefix = prefix;
+      t.tx = &segment_.stats(id).tx;
+      t.fast = !is_event && d.value_bytes == 8 && wire::FrameWriter::IsWordPrefix(prefix) &&
+               consumers_[id].size() == 1 && !large_[id];
+      if (t.fast) t.peer = &peers_tx_[consumers_[id][0]];
     }
     if (!(d.flags & store::kSigConsumedHere)) continue;
     RxSignal& r = rx_signals_[id];

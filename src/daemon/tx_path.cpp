@@ -71,7 +71,59 @@ __attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const s
   tx.store(tx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
 
+// The common case (TxSignal::fast: a state, one int64/double, one stream) in a small
+// function of its own, so that it saves and restores few registers; every rarer case
+// (no frame open or full, a damaged copy, values to catch up) calls out of line.
 void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
+  TxSignal& s = tx_signals_[id];
+  if (!s.fast) return CollectSignalSlow(id, now, periodic);
+  // A local copy: the acquire loads below would make the compiler reload it from `s`.
+  const store::StateView sv = s.state;
+  const uint64_t version = store::StateVersion(sv);
+  // Event-driven: send each new value once. Periodic: send the last value every period.
+  // (No test of version 0 here: `forwarded` is then 0 too, or the read below finds kNever.)
+  if (!periodic && version == store::StateForwarded(sv)) return;
+  // m and word never leave this function by address: they stay in registers.
+  store::SlotMeta m;
+  uint64_t word;
+  const store::StoreResult r = store::StateReadCopies(sv, &word, &m, 8);  // verifies the copy's check
+  if (__builtin_expect(r != store::StoreResult::kOk, 0)) return TxReadFailed(id, r);  // never forwarded
+  store::MarkStateForwarded(sv, version);
+  if (!periodic) {
+    collected_states_[collected_count_++] = id;  // at most once per signal and round
+    const uint64_t last = s.last_seq;
+    if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0))  // as in CollectSignalSlow
+      CatchUpAndCount(id, last, m.value_seq, now);
+  }
+  s.last_seq = m.value_seq;
+  PeerTx& p = *s.peer;
+  const uint32_t seq = static_cast<uint32_t>(m.value_seq);
+  if (__builtin_expect(p.open && p.writer.AddWord(s.prefix, seq, m.source_time_ns, word), 1)) {
+    s.tx->store(s.tx->load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // its only writer
+    return;
+  }
+  AddEntryOutOfLine(id, m.value_seq, m.source_time_ns, word, now);  // no frame open, or it is full (counts tx)
+}
+
+__attribute__((noinline, cold)) void Daemon::TxReadFailed(uint32_t id, store::StoreResult r) {
+  if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
+}
+
+__attribute__((noinline)) void Daemon::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
+                                                       uint64_t now) {
+  const uint64_t gone = CatchUp(id, segment_.dir(id), last_sent, newest, now);
+  if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
+}
+
+__attribute__((noinline)) void Daemon::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
+                                                         uint64_t word, uint64_t now) {
+  store::SlotMeta m;  // AddEntry uses these two of it
+  m.value_seq = value_seq;
+  m.source_time_ns = source_time_ns;
+  AddEntry(id, segment_.dir(id), 0, m, &word, now);
+}
+
+void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   if (large_[id] && !sending_large_) {  // sent after the round's small entries
     large_pending_.push_back({id, periodic});
     return;
@@ -101,8 +153,8 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
-  if (!periodic) collected_states_.push_back(id);  // preallocated: at most one per signal
-  uint64_t& last = last_tx_seq_[id];
+  if (!periodic) collected_states_[collected_count_++] = id;  // at most once per signal and round
+  uint64_t& last = tx_signals_[id].last_seq;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
   if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {
@@ -152,14 +204,15 @@ void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
     const uint32_t steps_now = h->steps_done.load(std::memory_order_acquire);
     if (steps_now == steps_before) return;
     steps_before = steps_now;
-    for (uint32_t id : collected_states_) {
+    for (uint32_t i = 0; i < collected_count_; ++i) {
+      const uint32_t id = collected_states_[i];
       const store::StateView& sv = tx_state_[id];
       const uint64_t version = store::StateVersion(sv);
       if (version == store::StateForwarded(sv)) continue;  // unchanged since it was taken
       store::SlotMeta m;
       if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) continue;
       store::MarkStateForwarded(sv, version);
-      uint64_t& last = last_tx_seq_[id];
+      uint64_t& last = tx_signals_[id].last_seq;
       if (m.value_seq <= last) continue;
       // The newer step's values follow the ones already in the frame (and any between,
       // from the slots): each step leaves whole, in order, and nothing is replaced.
@@ -184,7 +237,7 @@ void Daemon::RunTx() {
     uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
     uint64_t now = platform::MonotonicNs();
     const uint32_t steps_before = h->steps_done.load(std::memory_order_acquire);
-    collected_states_.clear();
+    collected_count_ = 0;
     for (uint32_t w = 0; w < words; ++w) {
       uint64_t bits = dirty[w].exchange(0, std::memory_order_acq_rel);
       while (bits) {

@@ -141,19 +141,29 @@ class FrameWriter {
   /// not fit, if prefix is 0, or if the frame is a heartbeat or not begun.
   /// Inline for one 8-byte element (a double or int64 signal), the rest out of line.
   bool AddPrepared(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, const void* value, size_t value_len) {
-    const uint8_t type = reinterpret_cast<const uint8_t*>(&prefix)[2];  // the entry's type byte
-    // limit_ - len_ is the room left: 0 before a successful Begin, none in a heartbeat.
-    const bool word_type = type < 8 && ((0x50u >> type) & 1);  // int64 (4) or double (6)
-    if (value_len != 8 || !word_type || value == nullptr || EntrySize(8) > limit_ - len_)
+    if (value_len != 8 || !IsWordPrefix(prefix) || value == nullptr)
       return AddPreparedGeneric(prefix, seq, source_time_ns, value, value_len);
-    uint8_t* p = buf_ + len_;
     uint64_t x;
     std::memcpy(&x, value, 8);
+    return AddWord(prefix, seq, source_time_ns, x);
+  }
+  /// Whether `prefix` (an EntryPrefix) is that of a one-element int64 or double entry:
+  /// then AddWord may encode it. A sender checks this once per signal, not per value.
+  static bool IsWordPrefix(uint64_t prefix) {
+    const uint8_t type = reinterpret_cast<const uint8_t*>(&prefix)[2];  // the entry's type byte
+    return prefix != 0 && type < 8 && ((0x50u >> type) & 1);           // int64 (4) or double (6)
+  }
+  /// AddPrepared of an entry with IsWordPrefix(prefix) (the caller checked it once): `word`
+  /// is the value's 8 bytes in host order. Only the room is checked here: false if it would
+  /// not fit, if the frame is a heartbeat or not begun (limit_ - len_ is then too small).
+  bool AddWord(uint64_t prefix, uint32_t seq, uint64_t source_time_ns, uint64_t word) {
+    if (EntrySize(8) > limit_ - len_) return false;
+    uint8_t* p = buf_ + len_;
     std::memcpy(p, &prefix, 8);
     be::Store<uint32_t>(p + 8, seq);
     be::Store<uint32_t>(p + 12, 0);
     be::Store<uint64_t>(p + 16, source_time_ns);
-    be::Store<uint64_t>(p + kEntryHeaderSize, x);
+    be::Store<uint64_t>(p + kEntryHeaderSize, word);
     len_ += EntrySize(8);
     ++count_;
     return true;

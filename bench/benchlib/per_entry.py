@@ -91,7 +91,8 @@ def section(R, meta, us, ratio_rows):
          "(`ccomm_read`). The 288 B board->board case is measured twice: as 36 separate double signals "
          "(the thesis' setup simulation: 36 entries per frame) and as one signal holding a 36-element "
          "double array (one entry per frame, the same bytes); both next to the plain-socket floor "
-         "carrying 288 B, alternated in the same run.\n" % (meta.get("command", "scripts/bench"),
+         "carrying 288 B, alternated in the same run (each ccomm half between two floor halves, its ratio "
+         "taken to their mean).\n" % (meta.get("command", "scripts/bench"),
                                                                meta.get("date", "?"), meta.get("git_commit", "?"))]
     lines = []
     for label, c, f, pairs, x, target in ratio_rows:

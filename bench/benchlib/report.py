@@ -42,10 +42,18 @@ def _ratio(a, b):
 
 
 def _paired_ratios(a, b):
-    """Ratios of the p50s of repeated halves, alternation by alternation (NAME~1 with
-    NAME~1, ...), or [] when the rows were not measured in alternation."""
+    """Ratios of the p50s of repeated halves, alternation by alternation, or [] when the
+    rows were not measured in alternation. a's half k ran after b's half k (ratio to it);
+    when b has one half more (a closing one), a's half k ran between b's halves k and k+1
+    and is compared with their mean."""
     ra, rb = (a or {}).get("rep_p50_ns") or [], (b or {}).get("rep_p50_ns") or []
-    if len(ra) < 2 or len(ra) != len(rb):
+    if len(ra) < 2:
+        return []
+    if len(rb) == len(ra) + 1:
+        if not all(rb):
+            return []
+        rb = [(x + y) / 2.0 for x, y in zip(rb, rb[1:])]
+    if len(ra) != len(rb):
         return []
     return [x / float(y) for x, y in zip(ra, rb) if x and y]
 
@@ -173,8 +181,8 @@ def checks(R, meta):
             c, f = R.get("ccomm_%s_oneway_block_1khz_p%d" % (t, p)), R.get("net_%s_oneway_1khz_p%d" % (t, p))
             pooled = _ratio(c, f)
             pairs = _paired_ratios(c, f)
-            # Judged: the median of the alternations' ratios (each ccomm half next to the
-            # floor half measured just before it), robust to a burst of host load.
+            # Judged: the median of the alternations' ratios (each ccomm half against the
+            # floor halves measured just before and after it), robust to a burst of host load.
             x = _median(pairs) if pairs else pooled
             ok = None if x is None else x <= TARGETS["b2b_raw_ratio"]
             detail = "n/a (row missing)" if x is None else "ccomm p50 %s µs vs floor %s µs = %.2fx%s" % (
@@ -894,9 +902,10 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
         L.append("app -> ccommd -> wire -> ccommd -> app at 1 kHz, against plain sockets (no daemon) between "
                  "the same namespaces and LCM %s. Ratio: p50 against the floor with the same transport, payload "
                  "and metric (one-way rows against `net_*_oneway`, RTT/2 rows against `net_*_rtt_half`). The one-way "
-                 "blocking rows ran in four alternations, floor then ccomm, each of 1-2 s; the rows pool the "
-                 "samples of all four, and the target table judges the median of the four ratios taken pair by "
-                 "pair, so that a burst of load on the shared host during one alternation does not decide it.\n" %
+                 "blocking rows ran in four alternations, floor then ccomm, each of 1-2 s, and a closing floor half; "
+                 "the rows pool the samples of all halves, and the target table judges the median of the four "
+                 "ratios of each ccomm half to the mean of the floor halves just before and after it, so that "
+                 "neither a host drifting during the run nor a burst of load during one alternation decides it.\n" %
                  (meta.get("versions") or {}).get("liblcm1", ""))
 
         def bref(r):

@@ -106,15 +106,19 @@ def plan(smoke=False, rates=None, scale=1.0):
     # machine the conditions drift, and the ratio should see the same ones.
     # The headline pairs (ccomm one-way against the plain-socket floor) alternate twice,
     # floor / ccomm / floor / ccomm, and each side's two halves are merged into one row.
-    # Four alternations: the report judges the median of the four ratios floor/ccomm
-    # pair by pair, which a burst of load on the host during one of them cannot sway.
+    # Four alternations and a closing floor half (floor / ccomm / ... / ccomm / floor):
+    # each ccomm half sits between two floor halves and the report judges it against
+    # their mean, so a host that drifts during the run cancels out to first order; the
+    # median of the four ratios is what a burst of load during one of them cannot sway.
     d = secs(2.0, 0.6)
     for t in ("raw", "udp"):
         for p in (8, 288):
-            for rep in ((1, 2, 3, 4) if not smoke else (1,)):
+            for rep in ((1, 2, 3, 4, 5) if not smoke else (1,)):
                 suffix = "" if smoke else REPEAT % rep
                 cases.append(Case("net_%s_oneway_1khz_p%d%s" % (t, p, suffix), "net", "b2b",
                                   n(1000, 300), p, 1000, {"transport": t, "role": "oneway"}))
+                if rep == 5:
+                    break  # the closing floor half
                 cases.append(CCase("ccomm_%s_oneway_block_1khz_p%d%s" % (t, p, suffix), "b2b", "ccomm_pair",
                                    d,
                                    {"transport": t, "signals": p // 8, "mode": "oneway", "style": "block",

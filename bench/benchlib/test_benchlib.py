@@ -127,6 +127,16 @@ class PairedRatioTest(unittest.TestCase):
               if k["text"].startswith("board->board raw one-way, 8 B")][0]
         self.assertEqual(ck["status"], "MISSED")
 
+    def test_closing_floor_half_brackets_each_ccomm_half(self):
+        # Floor drifting 40 -> 60 us over the run, ccomm always 1.1x the floor of its moment:
+        # against the floor half before it alone it reads 1.2-1.38x, against the mean of the
+        # halves around it 1.1x.
+        c = self.row("ccomm_raw_oneway_block_1khz_p8", [49500, 60500, 71500, 82500])
+        f = self.row("net_raw_oneway_1khz_p8", [40000, 50000, 60000, 70000, 80000])
+        self.assertEqual([round(x, 3) for x in report._paired_ratios(c, f)], [1.1, 1.1, 1.1, 1.1])
+        self.assertEqual([round(x, 3) for x in report._paired_ratios(c, dict(f, rep_p50_ns=f["rep_p50_ns"][:4]))],
+                         [1.238, 1.21, 1.192, 1.179])
+
     def test_unpaired_rows_fall_back_to_pooled(self):
         self.assertEqual(report._paired_ratios({"rep_p50_ns": [1, 2]}, {"rep_p50_ns": [1]}), [])
         self.assertEqual(report._median([3.0, 1.0, 2.0, 10.0]), 2.5)

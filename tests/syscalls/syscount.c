@@ -4,6 +4,8 @@
  *
  *   syscount SLEEPY_NODE BUSY_NODE [CALLS]
  *
+ *   syscount --board-clock SLEEPY_NODE BUSY_NODE [CALLS]   (under LD_PRELOAD=board_clock.so)
+ *
  * Forks a child that runs loops of ccomm_read / ccomm_write / ccomm_flush in each
  * doorbell mode (default, CCOMM_OPEN_NO_DOORBELL, CCOMM_OPEN_BATCH) against a ccommd
  * that sleeps between frames (SLEEPY_NODE, spin_us 0) and one that never sleeps
@@ -15,7 +17,8 @@
  * per call and a least total (a phase that must wake someone has to show it did), and
  * a self-check phase of getppid() calls proves the counter counts. Exit 0 if every
  * phase is within its bounds, 1 otherwise, 2 on a usage or set-up error, 4 when
- * ptrace is not permitted.
+ * ptrace is not permitted. --board-clock: the loops of board_clock_workload (below), the
+ * clock readings of reads, writes and a whole control cycle on a board without a vDSO clock.
  */
 #define _GNU_SOURCE
 #include <ccomm/ccomm.h>
@@ -198,6 +201,60 @@ static void workload(const char* sleepy, const char* busy, long n) {
   ccomm_close(plain);
 }
 
+/* The loops of a control cycle on a board whose clock reading is a system call (run
+ * under board_clock.so, see there): each call that reads the clock shows as one
+ * clock_gettime. A loop that takes the cycle's time once (ccomm_now + ccomm_set_time, as
+ * the 20-sim target and ccomm-latency do) must make no clock reading in its reads and
+ * writes, and exactly one per cycle. */
+#define CYCLE_READS 36 /* the thesis' setup simulation: 36 doubles in, 9 out */
+#define CYCLE_WRITES 9
+
+static void board_clock_workload(const char* sleepy, long n) {
+  ccomm_client* quiet = open_or_die(sleepy, CCOMM_OPEN_NO_DOORBELL);
+  ccomm_signal fwd = find_or_die(quiet, "sleepy_state");
+  ccomm_signal rx = find_or_die(quiet, "busy_state");
+  double v = 0;
+  ccomm_info info;
+  long i;
+  int k;
+
+  begin("self-check:getppid", n, 1, n);
+  for (i = 0; i < n; ++i) syscall(SYS_getppid);
+  end();
+  /* The emulation itself: every clock reading must be a system call here. */
+  begin("board-clock:self-check,ccomm_now", n, 1, n);
+  for (i = 0; i < n; ++i) (void)ccomm_now();
+  end();
+  must(ccomm_write_double(quiet, fwd, 1.0), "first write");
+  begin("board-clock:read,clock-per-call", n, 1, n);
+  for (i = 0; i < n; ++i) must(ccomm_read_double(quiet, rx, &v, &info), "read busy_state");
+  end();
+  begin("board-clock:write,clock-per-call", n, 1, n);
+  for (i = 0; i < n; ++i) must(ccomm_write_double(quiet, fwd, (double)i), "write");
+  end();
+  must(ccomm_set_time(quiet, ccomm_now()), "set_time");
+  begin("board-clock:read,cycle-time", n, 0, 0);
+  for (i = 0; i < n; ++i) must(ccomm_read_double(quiet, rx, &v, &info), "read busy_state");
+  end();
+  begin("board-clock:write+flush,cycle-time", n, 0, 0);
+  for (i = 0; i < n; ++i) {
+    must(ccomm_write_double(quiet, fwd, (double)i), "write");
+    must(ccomm_flush(quiet), "flush");
+  }
+  end();
+  /* A whole control cycle: the time once, 36 reads, 9 writes, the flush. */
+  long cycles = n / (CYCLE_READS + CYCLE_WRITES) > 100 ? n / (CYCLE_READS + CYCLE_WRITES) : 100;
+  begin("board-clock:control-cycle-36r-9w,cycle-time", cycles, 1, cycles);
+  for (i = 0; i < cycles; ++i) {
+    must(ccomm_set_time(quiet, ccomm_now()), "set_time");
+    for (k = 0; k < CYCLE_READS; ++k) must(ccomm_read_double(quiet, rx, &v, &info), "read busy_state");
+    for (k = 0; k < CYCLE_WRITES; ++k) must(ccomm_write_double(quiet, fwd, v + k), "write");
+    must(ccomm_flush(quiet), "flush");
+  }
+  end();
+  ccomm_close(quiet);
+}
+
 /* ---- the parent: the tracer -------------------------------------------------------- */
 
 struct phase {
@@ -333,15 +390,22 @@ static int report(const struct phase* phases, int n) {
 }
 
 int main(int argc, char** argv) {
+  int board_clock = argc > 1 && strcmp(argv[1], "--board-clock") == 0;
+  if (board_clock) {
+    ++argv;
+    --argc;
+  }
   if (argc < 3 || argc > 4 || strcmp(argv[1], "--help") == 0) {
     fprintf(stderr,
-            "usage: syscount SLEEPY_NODE BUSY_NODE [CALLS]\n"
+            "usage: syscount [--board-clock] SLEEPY_NODE BUSY_NODE [CALLS]\n"
             "Counts the syscalls of libccomm reads, writes and flushes per call (ptrace), in\n"
             "each doorbell mode, against a running ccommd for each node: SLEEPY_NODE with\n"
             "spin_us 0 and signals sleepy_state (forwarded), sleepy_local, busy_state;\n"
             "BUSY_NODE with spin_us >= its heartbeat. CALLS per phase: default 20000.\n"
             "Exit 0: every phase within its bound; 1: some phase above it; 2: set-up error.\n"
-            "SYSCOUNT_MARKDOWN=FILE also writes the table to FILE as Markdown.\n");
+            "SYSCOUNT_MARKDOWN=FILE also writes the table to FILE as Markdown.\n"
+            "--board-clock: the clock readings of a control cycle instead; run it with\n"
+            "LD_PRELOAD=board_clock.so, which makes each clock reading a system call.\n");
     return 2;
   }
   long n = argc == 4 ? strtol(argv[3], NULL, 10) : 20000;
@@ -361,7 +425,8 @@ int main(int argc, char** argv) {
       _exit(errno == EPERM ? 4 : 2); /* 4: not permitted here, a skip */
     }
     raise(SIGSTOP);
-    workload(argv[1], argv[2], n);
+    if (board_clock) board_clock_workload(argv[1], n);
+    else workload(argv[1], argv[2], n);
     _exit(0);
   }
   static struct phase phases[MAX_PHASES];

@@ -22,6 +22,7 @@ when the timing is outside the tolerance.
   recordcheck.py daemons STATS.json...             where values went missing, by ccommd (`ccomm stats --json`)
 """
 import json
+import os
 import re
 import sys
 from collections import defaultdict
@@ -144,6 +145,7 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
     wrong = missing = n = 0
     tally = [0, 0]
     errs = []
+    worst_at: list = [0, "", 0, 0.0]  # signed error (ns), signal, seq, offset in the recording (s)
     for name in sorted(a):
         va, vb = a[name], b[name]
         seqs = [v[0] for v in vb]
@@ -165,10 +167,17 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
         t0a, t0b = va[vb[0][0] - 1][2], vb[0][2]
         for y in vb:
             x = va[y[0] - 1]
-            errs.append(abs((y[2] - t0b) - (x[2] - t0a)))
+            err = (y[2] - t0b) - (x[2] - t0a)
+            errs.append(abs(err))
+            if abs(err) > abs(worst_at[0]):
+                worst_at[:] = [err, name, y[0], (x[2] - t0a) / 1e9]
             n += 1
     errs.sort()
     worst = errs[-1] if errs else 0
+    if worst_at[1]:
+        print(f"# replay: the largest timing error {worst_at[0] / 1e6:+.3f} ms ({'late' if worst_at[0] > 0 else 'early'}): "
+              f"{worst_at[1]} seq {worst_at[2]}, {worst_at[3]:.3f} s into the recording; "
+              f"{sum(1 for e in errs if e > tol_ms * 1e6)} values beyond {tol_ms} ms")
     p99 = errs[int(0.99 * (len(errs) - 1))] if errs else 0
     print(f"# replay: {n} values equal and in order, {missing} missing ({tally[0]} coalesced at the producer, "
           f"{tally[1]} lost on the way); "
@@ -177,7 +186,19 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
         return 1
     # The documented tolerance: p99 within a fifth of it, every value within it (a Python
     # replayer on a general-purpose kernel: the odd wake-up is late, the bulk is not).
-    if worst > tol_ms * 1e6 or p99 > tol_ms * 1e6 / 5:
+    if p99 > tol_ms * 1e6 / 5:
+        return 4
+    if worst > tol_ms * 1e6:
+        # The floor (tests/record/run): the longest the machine itself kept cyclictest, above
+        # every task of the test, from running. A stall of at least half the worst error in
+        # the same window explains it; anything else is the replayer's (or ccomm's) doing.
+        stall_ns = float(os.environ.get("RECORDCHECK_HOST_STALL_US", "0")) * 1e3
+        if stall_ns >= worst / 2:
+            print(f"# the worst value's {worst / 1e6:.3f} ms is the machine's: cyclictest above every task of the "
+                  f"test was kept from running for {stall_ns / 1e6:.3f} ms in the same window")
+            return 5
+        print(f"# the machine itself stalled at most {stall_ns / 1e6:.3f} ms in that window (cyclictest): "
+              f"not the cause")
         return 4
     return 3 if missing else 0
 

@@ -297,24 +297,31 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
             "heartbeats_max": max(hb.values()), "coalesced": coalesced_total, "late_app_cycles": late_total}
 
 
-def check_kill(r, res, n, nodes, victim, t_kill, t_restart):
+def check_kill(r, res, n, nodes, victim, t_kill, t_dead, t_restart):
     """Phase 2: the victim's signals go stale on every consumer within stale_after_ms
-    (+ tolerance) of the kill and fresh again after the restart; no other signal blinks."""
+    (+ tolerance) of the kill and fresh again after the restart; no other signal blinks.
+    The kill is judged from t_dead (its ccommd reaped): this harness is not real-time, and
+    between its clock reading t_kill and the SIGKILL landing it can be descheduled (CI saw
+    11 ms), while the victim still sends. The contract itself is judged exactly by what each
+    reader saw: the value's age at its first stale read (stale_after_ms + the reader's delay)."""
     a = r.args
     tol_ns = a.stale_tolerance_ms * 1_000_000
     limit = a.stale_after_ms * 1_000_000 + tol_ns
     vname = config.board(victim)
-    late, never_fresh, false_alarm, delays, back = [], [], [], [], []
+    late, never_fresh, false_alarm, delays, ages, back = [], [], [], [], [], []
     for name in nodes:
         for s, v in res[name]["consumed"].items():
             if s.startswith(vname + "_"):
                 first_stale = [t for t in v["stale_at"] if t >= t_kill]
                 fresh_after = [t for t in v["fresh_at"] if t >= t_restart]
-                if not first_stale or first_stale[0] - t_kill > limit:
-                    late.append("%s %s %s" % (name, s, "%.1f ms" % ((first_stale[0] - t_kill) / 1e6)
+                age = v.get("max_stale_age_ns", 0)
+                if not first_stale or first_stale[0] - t_dead > limit or age > limit:
+                    late.append("%s %s %s" % (name, s, "%.1f ms after the kill, age %.1f ms at the first stale read"
+                                              % ((first_stale[0] - t_dead) / 1e6, age / 1e6)
                                               if first_stale else "never stale"))
                 else:
-                    delays.append(first_stale[0] - t_kill)
+                    delays.append(first_stale[0] - t_dead)
+                    ages.append(age)
                 if not fresh_after or v["to_fresh"] != v["to_stale"]:
                     never_fresh.append("%s %s" % (name, s))
                 else:
@@ -322,8 +329,11 @@ def check_kill(r, res, n, nodes, victim, t_kill, t_restart):
             elif v["to_stale"] and name != vname:
                 false_alarm.append("%s %s x%d" % (name, s, v["to_stale"]))
     r.check(not late and delays, "consumers flag %s's signals stale within stale_after_ms %d + %d ms of the kill "
-            "(%d reads; slowest %.1f ms)%s" % (vname, a.stale_after_ms, a.stale_tolerance_ms, len(delays),
-                                              max(delays) / 1e6 if delays else -1, "" if not late else ": " + "; ".join(late[:6])))
+            "(%d signals on time; slowest %.1f ms after its ccommd was reaped, %.1f ms after the kill was decided; "
+            "ages at the first stale read %.1f-%.1f ms)%s"
+            % (vname, a.stale_after_ms, a.stale_tolerance_ms, len(delays), max(delays) / 1e6 if delays else -1,
+               (max(delays) + t_dead - t_kill) / 1e6 if delays else -1, min(ages) / 1e6 if ages else -1,
+               max(ages) / 1e6 if ages else -1, "" if not late else ": " + "; ".join(late[:6])))
     r.check(not never_fresh and back, "fresh again after the restart (slowest %.0f ms after ccommd restarted)%s"
             % (max(back) / 1e6 if back else -1, "" if not never_fresh else ": " + "; ".join(never_fresh[:6])))
     r.check(not false_alarm, "no other board's signal went stale meanwhile%s"
@@ -390,6 +400,7 @@ def system(args):
             t_kill = time.monotonic_ns()
             daemons[vname].send_signal(signal.SIGKILL)
             daemons[vname].wait()
+            t_dead = time.monotonic_ns()
             time.sleep(1.0)
             t_restart = time.monotonic_ns()
             daemons[vname] = r.spawn(victim, [bin_path(args, "ccommd"), "--node", vname, "-c", cfg],
@@ -398,7 +409,7 @@ def system(args):
             res = collect_apps(apps, kill_seconds + 30)
             r.check(all(res.values()), "every application ran through the kill and restart")
             if all(res.values()):
-                summary.update(check_kill(r, res, n, nodes, victim, t_kill, t_restart))
+                summary.update(check_kill(r, res, n, nodes, victim, t_kill, t_dead, t_restart))
         return r, summary
     finally:
         r.close()

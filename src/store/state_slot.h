@@ -60,7 +60,7 @@ inline bool ClaimInline(const StateView& v, uint64_t t) { return ClaimCopy(&v.ce
 /// Fills the inline copy (the caller holds the inline claim for ticket t).
 inline void FillInline(const StateView& v, uint64_t t, const SlotMeta& meta, const void* value) {
   StateCell* c = v.cell;
-  c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
+  c->inline_seq.store(2 * t + 1, std::memory_order_release);  // after `latest` passed the last copy (StateReadCopies)
   StampAndPublish(&c->inline_seq, c->inline_meta, reinterpret_cast<uint8_t*>(c->inline_value), t, v.value_bytes,
                   value, meta);
 }
@@ -124,7 +124,7 @@ __attribute__((always_inline)) inline void StateWriteSingleCopies(const StateVie
   StampCheckedAndPublish(&h->seq, &h->value_seq, reinterpret_cast<uint8_t*>(h + 1), t, value_bytes, value, meta,
                          check);
   if (value_bytes <= kInlineValueBytes) {
-    c->inline_seq.store(2 * t + 1, std::memory_order_relaxed);
+    c->inline_seq.store(2 * t + 1, std::memory_order_release);  // after `latest` passed the last copy (StateReadCopies)
     StampCheckedAndPublish(&c->inline_seq, c->inline_meta, reinterpret_cast<uint8_t*>(c->inline_value), t,
                            value_bytes, value, meta, check);
   }
@@ -158,8 +158,7 @@ __attribute__((always_inline)) inline StoreResult StateReadCopies(const StateVie
     uint64_t t = latest - 1;
     if (value_bytes <= kInlineValueBytes) {
       // The inline copy, if complete and not older than `latest`: it may be newer (its
-      // writer has not published yet), never older than anything a later read can
-      // fall back to, since its writer publishes before another can refill it.
+      // writer has not published yet).
       uint64_t s1 = v.cell->inline_seq.load(std::memory_order_acquire);
       if (!(s1 & 1) && s1 >= 2 * t + 2) {
         uint64_t ti = s1 / 2 - 1;
@@ -170,6 +169,14 @@ __attribute__((always_inline)) inline StoreResult StateReadCopies(const StateVie
         if (r == CopyResult::kCorrupt) return StoreResult::kCorrupt;
         continue;  // refilled while we copied
       }
+      // Not usable (being rewritten, or older than `latest`): the slot of `latest`, loaded
+      // again after s1. A copy is rewritten only after its last value's writer raised
+      // `latest` past it (and the rewrite's first store is a release), so the reloaded
+      // `latest` is never older than a copy this reader returned before. The `latest` of
+      // the first load can be: loaded, then the writer publishes and starts the next
+      // copy, and its slot would hand the reader an older value than its last read.
+      latest = v.cell->latest.load(std::memory_order_acquire);
+      t = latest - 1;
     }
     const CopyResult r = ReadSlot(v.slot(t), t, value_bytes, out, meta);
     if (r == CopyResult::kOk) return StoreResult::kOk;

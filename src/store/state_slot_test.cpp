@@ -211,6 +211,46 @@ TEST_P(StateSlotConcurrent, ReadersNeverSeeTornValues) {
   EXPECT_GT(reads.load(), 100u);
 }
 
+// One application writing (the ticketed protocol), readers polling: a reader never gets
+// an older value than its last read. The inline copy can be newer than `latest`; a read
+// that finds it being rewritten must not fall back to the slot of a `latest` it loaded
+// before the rewrite began (it did once: a backwards read for 16-byte values).
+class StateSlotOneWriter : public testing::TestWithParam<int> {};
+INSTANTIATE_TEST_SUITE_P(Sizes, StateSlotOneWriter, testing::Values(1, 2));
+
+TEST_P(StateSlotOneWriter, ReadersNeverGoBackwards) {
+  const int kWords = GetParam();
+  Cell c(kWords * 8);
+  std::atomic<bool> stop{false};
+  std::atomic<uint64_t> reads{0};
+  std::atomic<int> backwards{0};
+  std::vector<std::thread> threads;
+  threads.emplace_back([&] {
+    uint64_t vals[2];
+    for (uint64_t i = 1; !stop.load(std::memory_order_relaxed); ++i) {
+      vals[0] = vals[1] = i;
+      StateWrite(c.view, vals, i, 0, 0);
+    }
+  });
+  for (int r = 0; r < 2; ++r) {
+    threads.emplace_back([&] {
+      uint64_t vals[2], last = 0;
+      SlotMeta m;
+      while (!stop.load(std::memory_order_relaxed)) {
+        if (StateRead(c.view, vals, &m) != StoreResult::kOk) continue;
+        reads++;
+        if (m.value_seq < last) backwards++;
+        last = m.value_seq;
+      }
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  stop = true;
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(backwards.load(), 0);
+  EXPECT_GT(reads.load(), 100u);
+}
+
 }  // namespace
 }  // namespace store
 }  // namespace ccomm

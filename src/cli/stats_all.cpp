@@ -44,17 +44,19 @@ void PrintJson(ccomm_client* c, ccomm_view* v) {
          ",\"refused\":%" PRIu64 ",\"old\":%" PRIu64 ",\"send_errors\":%" PRIu64 "},\"nodes\":[",
          Json(ccomm_node_name(c)).c_str(), vc.summary_ms, vc.summaries_tx, vc.summaries_rx, vc.summaries_refused,
          vc.summaries_old, vc.summaries_send_errors);
+  bool first_node = true;
   for (int n = 0; n < ccomm_node_count(c); ++n) {
     ccomm_view_node vn;
-    if (ccomm_view_get_node(v, n, &vn) != 0) continue;
+    if (ccomm_view_get_node(v, n, &vn) != 0) continue;  // busy for 50 ms: left out of this snapshot
     printf("%s{\"name\":\"%s\",\"self\":%s,\"reported\":%s,\"alive\":%s,\"age_ms\":%.1f,\"timeout_ms\":%.0f,"
            "\"uptime_s\":%.3f,\"peers_alive\":[%s],\"frames_rx\":%" PRIu64 ",\"frames_tx\":%" PRIu64
            ",\"frames_bad\":%" PRIu64 ",\"frames_lost\":%" PRIu64 ",\"socket_drops\":%" PRIu64
            ",\"cycle_ms\":%u,\"summaries\":%" PRIu64 ",\"signals\":[",
-           n ? "," : "", Json(vn.name).c_str(), vn.is_self ? "true" : "false", vn.reported ? "true" : "false",
+           first_node ? "" : ",", Json(vn.name).c_str(), vn.is_self ? "true" : "false", vn.reported ? "true" : "false",
            vn.alive ? "true" : "false", Ms(vn.age_ns), Ms(vn.timeout_ns), static_cast<double>(vn.uptime_ns) / 1e9,
            PeerNames(c, vn.peers_alive, true).c_str(), vn.frames_rx, vn.frames_tx, vn.frames_bad, vn.frames_lost,
            vn.socket_drops, vn.cycle_ms, vn.summaries);
+    first_node = false;
     bool first = true;
     for (int s = 0; s < ccomm_signal_count(c); ++s) {
       ccomm_view_signal vs;

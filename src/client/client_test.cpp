@@ -8,10 +8,12 @@
 
 #include <array>
 #include <atomic>
-#include <vector>
+#include <chrono>
 #include <thread>
+#include <vector>
 
 #include "store/segment.h"
+#include "store/view.h"
 #include "common/platform.h"
 #include "daemon/segment_builder.h"
 #include "testing/test_config.h"
@@ -330,6 +332,40 @@ TEST_F(ClientTest, RetiredSegmentIsReported) {
   seg_a_.header()->state.store(store::kRetired);
   EXPECT_EQ(s.read().code, CCOMM_E_RETIRED);
   EXPECT_EQ(s.write(1.0f), CCOMM_E_RETIRED);
+}
+
+// ccommd descheduled in the middle of rewriting a node record (the seqlock odd for
+// milliseconds, longer than the store's spinning reader tries) must not make a monitoring
+// tool drop that node (CI: `ccomm stats --all --json` printed "nodes":[, with node 0
+// missing); only a record that stays odd (writer stopped mid-write) is CCOMM_E_BUSY.
+TEST_F(ClientTest, SystemViewWaitsOutAWriterDescheduledMidRewrite) {
+  store::View writer;
+  std::string err;
+  ASSERT_EQ(writer.Create(store::View::NameFor("a"), 2, 5, 0, 100, -1, &err), 0) << err;
+  writer.mutable_header()->state.store(store::kViewReady, std::memory_order_release);
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  ccomm_view* v = nullptr;
+  ASSERT_EQ(ccomm_view_open(c, &v), 0);
+  writer.BeginWrite(1);
+  std::thread finisher([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    writer.SetNodeWord(1, store::kVwUptimeNs, 7000000000ull);
+    writer.EndWrite(1);
+  });
+  ccomm_view_node vn;
+  EXPECT_EQ(ccomm_view_get_node(v, 1, &vn), 0);
+  finisher.join();
+  EXPECT_EQ(vn.uptime_ns, 7000000000ull);
+  writer.BeginWrite(0);  // never ended
+  EXPECT_EQ(ccomm_view_get_node(v, 0, &vn), CCOMM_E_BUSY);
+  ccomm_view_signal vs;
+  EXPECT_EQ(ccomm_view_get_signal(v, 0, 0, &vs), CCOMM_E_BUSY);
+  writer.EndWrite(0);
+  EXPECT_EQ(ccomm_view_get_node(v, 0, &vn), 0);
+  ccomm_view_close(v);
+  ccomm_close(c);
+  platform::ShmUnlink(store::View::NameFor("a").c_str());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // read-only, through the seqlock of each node record. Names come from the client's
 // segment through the public API.
 #include <errno.h>
+#include <time.h>
 
 #include <new>
 
@@ -22,6 +23,22 @@ constexpr uint32_t kNoAge = 0xFFFFFFFFu;  // wire::kSummaryNoAge
 const char* NodeName(const ccomm_view* v, int node) {
   ccomm_peer_stats ps;
   return ccomm_get_peer_stats(v->client, node, &ps) == 0 ? ps.name : "";
+}
+
+// A seqlock reader spins only a few times (store/view.h); a record stays odd for as long
+// as ccommd is descheduled mid-rewrite (a time slice, a VM stall), so this monitoring
+// API waits it out here, bounded, instead of handing every caller a retry loop.
+constexpr int kBusyWaits = 100;
+constexpr long kBusyWaitNs = 500000;  // 100 x 0.5 ms: at most ~50 ms
+
+template <typename Read>
+bool ReadPatiently(Read read) {
+  for (int i = 0;; ++i) {
+    if (read()) return true;
+    if (i == kBusyWaits) return false;
+    const struct timespec pause = {0, kBusyWaitNs};
+    nanosleep(&pause, nullptr);
+  }
 }
 
 bool Alive(const st::ViewNodeCopy& n, int64_t now) {
@@ -57,7 +74,7 @@ void ccomm_view_close(ccomm_view* v) { delete v; }
 int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out) {
   if (!v || !out || node < 0 || node >= static_cast<int>(v->view.header()->node_count)) return CCOMM_E_INVAL;
   st::ViewNodeCopy n;
-  if (!v->view.ReadNode(static_cast<uint32_t>(node), &n)) return CCOMM_E_BUSY;
+  if (!ReadPatiently([&] { return v->view.ReadNode(static_cast<uint32_t>(node), &n); })) return CCOMM_E_BUSY;
   const int64_t now = ccomm_now();
   *out = ccomm_view_node();
   out->name = NodeName(v, node);
@@ -85,8 +102,10 @@ int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_v
     return CCOMM_E_INVAL;
   st::ViewRowCopy r;
   st::ViewNodeCopy n;
-  if (!v->view.ReadRow(static_cast<uint32_t>(node), static_cast<uint32_t>(s), &r) ||
-      !v->view.ReadNode(static_cast<uint32_t>(node), &n))
+  if (!ReadPatiently([&] {
+        return v->view.ReadRow(static_cast<uint32_t>(node), static_cast<uint32_t>(s), &r) &&
+               v->view.ReadNode(static_cast<uint32_t>(node), &n);
+      }))
     return CCOMM_E_BUSY;
   if (!r.present) return CCOMM_E_NOENT;
   const int64_t now = ccomm_now();

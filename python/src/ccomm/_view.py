@@ -29,8 +29,10 @@ def system_view(handle: int) -> Dict[str, Any]:
             signals = []
             for s in range(n_signals):
                 vs = _native.ViewSignal()
-                if L.ccomm_view_get_signal(v, n, s, ctypes.byref(vs)) != 0:
+                rc = L.ccomm_view_get_signal(v, n, s, ctypes.byref(vs))
+                if rc == -2:  # CCOMM_E_NOENT
                     continue  # the node neither produces nor consumes it (or no report yet)
+                _check(rc, "system view")
                 signals.append({"name": vs.name.decode(), "role": _ROLES.get(vs.role, str(vs.role)),
                                 "rate": vs.rate, "lost": vs.lost, "stale": bool(vs.stale),
                                 "age_ms": vs.age_ns / 1e6 if vs.age_ns >= 0 else None})

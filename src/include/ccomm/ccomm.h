@@ -312,7 +312,8 @@ typedef struct ccomm_view_node {
   uint64_t summaries;      /**< summary parts of it applied here */
 } ccomm_view_node;
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or node index, CCOMM_E_BUSY if the record
- *  was being rewritten throughout (retry). */
+ *  was being rewritten throughout ~50 ms of waiting (ccommd stopped mid-rewrite). The view
+ *  calls may sleep: they are for monitoring tools, not for a control loop. */
 CCOMM_API int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out);
 
 /** One signal as node `node` reports it. */

@@ -26,6 +26,18 @@ struct ccomm_blk {
   unsigned char* scratch; /* event reads / last event sent */
 };
 
+/* The step clock (ccomm_blk_step): per thread, since each task of a multitasking model
+ * runs its steps on its own thread with its own model time. A compiler without thread-
+ * local storage gets a clock reading per block call instead (still correct). */
+#if defined(__GNUC__)
+#define CCOMM_BLK_STEP_CLOCK 1
+static __thread int step_clock_valid;
+static __thread double step_model_time;
+static __thread int64_t step_now_ns;
+#else
+#define CCOMM_BLK_STEP_CLOCK 0
+#endif
+
 int ccomm_blk_dtype(const char* name) {
   static const struct { const char* name; int id; } types[] = {
       {"double", CCOMM_BLK_DOUBLE}, {"single", CCOMM_BLK_SINGLE}, {"int32", CCOMM_BLK_INT32},
@@ -93,6 +105,9 @@ ccomm_blk* ccomm_blk_open_typed(const char* node, const char* signal, int width,
     if (err) snprintf(err, err_len, "ccomm: timeout %g s must be 0 (none) or a positive number of seconds", timeout_s);
     return NULL;
   }
+#if CCOMM_BLK_STEP_CLOCK
+  step_clock_valid = 0; /* a new run may start again at the old model time */
+#endif
   b = (ccomm_blk*)calloc(1, sizeof *b);
   if (!b) {
     if (err) snprintf(err, err_len, "ccomm: out of memory");
@@ -247,6 +262,20 @@ int ccomm_blk_write_port(ccomm_blk* b, const void* u) {
   if (b->type == CCOMM_BOOL)
     for (e = 0; e < b->count; e++) b->value[e] = b->value[e] ? 1 : 0;
   return send(b);
+}
+
+void ccomm_blk_step(ccomm_blk* b, double model_time) {
+  if (!b) return;
+#if CCOMM_BLK_STEP_CLOCK
+  if (!step_clock_valid || model_time != step_model_time) {
+    step_now_ns = ccomm_now();
+    step_model_time = model_time;
+    step_clock_valid = 1;
+  }
+  (void)ccomm_set_time(b->client, step_now_ns);
+#else
+  (void)model_time;
+#endif
 }
 
 void ccomm_blk_close(ccomm_blk* b) {

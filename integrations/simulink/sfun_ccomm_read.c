@@ -14,7 +14,7 @@
  *             configured; or older than the timeout), 2 never received, 3 no new
  *             event; negative = a ccomm error (see ccomm.h).
  * The signal is opened in mdlStart and closed in mdlTerminate; mdlOutputs makes one
- * non-blocking ccomm read. Code generation: sfun_ccomm_read.tlc calls the same
+ * non-blocking ccomm read, at the step's time (ccomm_blk_step). Code generation: sfun_ccomm_read.tlc calls the same
  * ccomm_blk.c functions.
  * Build: mex -I<prefix>/include -L<prefix>/lib -lccomm sfun_ccomm_read.c ccomm_blk.c
  */
@@ -45,7 +45,10 @@ static void mdlInitializeSizes(SimStruct* S) {
 }
 
 static void mdlOutputs(SimStruct* S, int_T tid) {
-  int r = ccomm_blk_read_port((ccomm_blk*)ssGetPWork(S)[0], ssGetOutputPortSignal(S, 0));
+  ccomm_blk* b = (ccomm_blk*)ssGetPWork(S)[0];
+  int r;
+  ccomm_blk_step(b, ssGetT(S)); /* one clock reading per model step, for all blocks */
+  r = ccomm_blk_read_port(b, ssGetOutputPortSignal(S, 0));
   UNUSED_ARG(tid);
   if (ssGetNumOutputPorts(S) > 1) ssGetOutputPortRealSignal(S, 1)[0] = (real_T)r;
 }

@@ -15,7 +15,8 @@
  * Output:     1 (status output on) the result of this sample's write: 0, or a
  *             negative ccomm error.
  * The signal is opened in mdlStart and closed in mdlTerminate; mdlOutputs makes one
- * non-blocking ccomm write (event signals: only when the value changed). Code
+ * non-blocking ccomm write at the step's time (ccomm_blk_step; event signals: only when
+ * the value changed). Code
  * generation: sfun_ccomm_write.tlc calls the same ccomm_blk.c functions.
  * Build: mex -I<prefix>/include -L<prefix>/lib -lccomm sfun_ccomm_write.c ccomm_blk.c
  */
@@ -48,7 +49,10 @@ static void mdlInitializeSizes(SimStruct* S) {
 }
 
 static void mdlOutputs(SimStruct* S, int_T tid) {
-  int r = ccomm_blk_write_port((ccomm_blk*)ssGetPWork(S)[0], ssGetInputPortSignal(S, 0));
+  ccomm_blk* b = (ccomm_blk*)ssGetPWork(S)[0];
+  int r;
+  ccomm_blk_step(b, ssGetT(S)); /* one clock reading per model step, for all blocks */
+  r = ccomm_blk_write_port(b, ssGetInputPortSignal(S, 0));
   UNUSED_ARG(tid);
   if (ssGetNumOutputPorts(S) > 0) ssGetOutputPortRealSignal(S, 0)[0] = (real_T)r;
 }

@@ -35,6 +35,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "ccomm_blk.h" /* the Simulink blocks' C layer (integrations/simulink) */
+
 /* glibc's <sys/ptrace.h> clashes with <linux/ptrace.h> (which has ptrace_syscall_info):
  * the raw system call instead. */
 #define ptrace(req, pid, addr, data) syscall(SYS_ptrace, (long)(req), (long)(pid), (long)(addr), (long)(data))
@@ -209,7 +211,39 @@ static void workload(const char* sleepy, const char* busy, long n) {
 #define CYCLE_READS 36 /* the thesis' setup simulation: 36 doubles in, 9 out */
 #define CYCLE_WRITES 9
 
-static void board_clock_workload(const char* sleepy, long n) {
+/* A Simulink model of 36 ccomm read and 9 ccomm write blocks, stepped as the S-functions
+ * and the generated code step them (ccomm_blk.c): each block its own handle; with
+ * `step_clock`, each block's call first gives ccomm_blk_step the step's model time. On
+ * BUSY_NODE, whose ccommd never sleeps, so writes ring no doorbell. */
+static void simulink_model_steps(const char* busy, long steps, int step_clock) {
+  ccomm_blk* blocks[CYCLE_READS + CYCLE_WRITES];
+  char err[256];
+  double y = 0;
+  long i;
+  int k;
+  for (k = 0; k < CYCLE_READS + CYCLE_WRITES; ++k) {
+    blocks[k] = k < CYCLE_READS ? ccomm_blk_open(busy, "sleepy_state", 1, 0, err, sizeof err)
+                                : ccomm_blk_open(busy, "busy_state", 1, 1, err, sizeof err);
+    if (!blocks[k]) {
+      fprintf(stderr, "syscount: %s\n", err);
+      _exit(2);
+    }
+  }
+  begin(step_clock ? "board-clock:simulink-36r-9w-blocks,step-clock" : "board-clock:simulink-36r-9w-blocks,per-block",
+        steps, step_clock ? 1 : CYCLE_READS + CYCLE_WRITES, step_clock ? steps : steps * (CYCLE_READS + CYCLE_WRITES));
+  for (i = 0; i < steps; ++i) {
+    const double model_time = (double)i * 0.001;
+    for (k = 0; k < CYCLE_READS + CYCLE_WRITES; ++k) {
+      if (step_clock) ccomm_blk_step(blocks[k], model_time);
+      if (k < CYCLE_READS) must(ccomm_blk_read(blocks[k], &y), "ccomm read block");
+      else must(ccomm_blk_write(blocks[k], &y), "ccomm write block");
+    }
+  }
+  end();
+  for (k = 0; k < CYCLE_READS + CYCLE_WRITES; ++k) ccomm_blk_close(blocks[k]);
+}
+
+static void board_clock_workload(const char* sleepy, const char* busy, long n) {
   ccomm_client* quiet = open_or_die(sleepy, CCOMM_OPEN_NO_DOORBELL);
   ccomm_signal fwd = find_or_die(quiet, "sleepy_state");
   ccomm_signal rx = find_or_die(quiet, "busy_state");
@@ -253,6 +287,8 @@ static void board_clock_workload(const char* sleepy, long n) {
   }
   end();
   ccomm_close(quiet);
+  simulink_model_steps(busy, cycles, 0);
+  simulink_model_steps(busy, cycles, 1);
 }
 
 /* ---- the parent: the tracer -------------------------------------------------------- */
@@ -364,7 +400,7 @@ static void report_markdown(const struct phase* phases, int n) {
 static int report(const struct phase* phases, int n) {
   report_markdown(phases, n);
   int failed = 0;
-  printf("%-42s %8s %9s %9s %8s  %s\n", "phase", "calls", "syscalls", "per call", "bound", "result (syscalls by name)");
+  printf("%-46s %8s %9s %9s %8s  %s\n", "phase", "calls", "syscalls", "per call", "bound", "result (syscalls by name)");
   for (int i = 0; i < n; ++i) {
     const struct phase* p = &phases[i];
     double per = p->calls ? (double)p->total / (double)p->calls : 0;
@@ -382,7 +418,7 @@ static int report(const struct phase* phases, int n) {
     char bound[32];
     if (p->min_total) snprintf(bound, sizeof bound, "%g>0", p->max_per_call);
     else snprintf(bound, sizeof bound, "%g", p->max_per_call);
-    printf("%-42s %8ld %9ld %9.4f %8s  %s%s\n", p->name, p->calls, p->total, per, bound, ok ? "ok" : "FAIL", by);
+    printf("%-46s %8ld %9ld %9.4f %8s  %s%s\n", p->name, p->calls, p->total, per, bound, ok ? "ok" : "FAIL", by);
     if (!ok && p->total < p->min_total)
       printf("  ^ expected at least %ld syscall(s): nothing was woken\n", p->min_total);
   }
@@ -425,7 +461,7 @@ int main(int argc, char** argv) {
       _exit(errno == EPERM ? 4 : 2); /* 4: not permitted here, a skip */
     }
     raise(SIGSTOP);
-    if (board_clock) board_clock_workload(argv[1], n);
+    if (board_clock) board_clock_workload(argv[1], argv[2], n);
     else workload(argv[1], argv[2], n);
     _exit(0);
   }

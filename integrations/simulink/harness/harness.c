@@ -100,7 +100,21 @@ static const char* block_start_typed(block* b, const harness_methods* m, const c
   return block_start_p(b, m, &bp);
 }
 
-static void step(block* b) { b->m->outputs(&b->s, 0); }
+/* Model time as a real-time target with a 1 ms base rate would give it: the steps' times
+ * follow the wall clock, and the blocks called within one millisecond share a step (and
+ * so one clock reading, ccomm_blk_step). */
+static double model_time(void) {
+  static struct timespec t0;
+  struct timespec now;
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  if (t0.tv_sec == 0 && t0.tv_nsec == 0) t0 = now;
+  return floor(((double)(now.tv_sec - t0.tv_sec) * 1e3 + (double)(now.tv_nsec - t0.tv_nsec) / 1e6)) / 1e3;
+}
+
+static void step(block* b) {
+  b->s.t = model_time();
+  b->m->outputs(&b->s, 0);
+}
 
 static void block_stop(block* b) {
   b->m->terminate(&b->s);

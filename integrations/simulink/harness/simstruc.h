@@ -81,6 +81,7 @@ typedef struct SimStruct {
   DTypeId in_dtype[HARNESS_MAX], out_dtype[HARNESS_MAX]; /* SS_DOUBLE unless set */
   void* in_signal[HARNESS_MAX];  /* contiguous, of the port's data type */
   void* out_signal[HARNESS_MAX];
+  double t; /* model time of the current step (ssGetT) */
   int n_sample_times;
   double sample_time[HARNESS_MAX], offset_time[HARNESS_MAX];
   int n_rwork, n_iwork, n_pwork, n_modes, n_zcs;
@@ -96,6 +97,7 @@ typedef struct SimStruct {
 #define UNUSED_ARG(x) ((void)(x))
 
 #define ssGetPath(S) ((S)->path)
+#define ssGetT(S) ((S)->t)
 /* -1: a variable number of parameters, which the S-function checks itself. */
 #define ssSetNumSFcnParams(S, n) ((S)->n_params_expected = (n))
 #define ssGetNumSFcnParams(S) ((S)->n_params_expected)

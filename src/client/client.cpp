@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-// libccomm: the C API (ccomm.h) over the shared-memory store. Reads and writes touch
-// only the signal's lines in the mapped segment and the handle's preallocated,
-// per-signal state (HandleSignal).
+// libccomm: the real-time calls of the C API (ccomm.h): read, write, flush, set_time,
+// wait. Reads and writes touch only the signal's lines in the mapped segment and the
+// handle's preallocated, per-signal state (HandleSignal, client_handle.h). Opening a
+// handle is client_open.cpp; statistics and descriptions client_info.cpp.
 #include "ccomm/ccomm.h"
 
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <new>
-
-#include "client/client_internal.h"
+#include "client/client_handle.h"
 #include "client/doorbell.h"
 #include "common/platform.h"
 #include "common/value_type.h"
@@ -23,52 +22,6 @@ using ccomm::store::SlotMeta;
 using ccomm::store::StoreResult;
 namespace st = ccomm::store;
 
-// The last copy a handle took of a state signal: while the cell's change words are
-// unchanged a read copies from here. A handle polling a signal then reads one or two
-// words of the cell per poll: it does not pull the writer's slot lines to its CPU, and
-// it holds the readers' line for as short a time as possible while the writer wants it.
-struct StateCache {
-  st::StateStamp stamp;      // the cell's stamp seen before the copy; version 0 = none
-  SlotMeta meta;
-  uint8_t* value = nullptr;  // value_bytes; null for event signals
-};
-
-// One signal as a handle sees it, resolved at open: a read or write touches this, the
-// signal's own lines in the segment and nothing else (no directory or header walks).
-struct HandleSignal {
-  uint32_t flags = 0;        // SignalFlags
-  uint32_t value_bytes = 0;
-  uint32_t count = 0;
-  uint8_t type = 0;
-  uint8_t read8_type = 0;    // `type` if a state of one 8-byte value (ReadState8), else 0
-  uint64_t stale_ns = 0;     // 0 = never stale
-  st::SignalStats* stats = nullptr;
-  const uint8_t* safe_value = nullptr;
-  st::StateView state;       // state signals
-  st::RingView ring;         // event signals
-  RingCursor cursor;         // event signals: this handle's position
-  StateCache cache;
-  uint64_t seen = 0;         // change counter at the last ccomm_wait()
-  uint8_t* pending = nullptr;   // CCOMM_OPEN_BATCH, state signals produced here: the value
-  uint64_t pending_ns = 0;      // written this step and its time, stored at the flush
-  bool has_pending = false;
-};
-
-struct ccomm_client {
-  Segment segment;
-  ccomm::client::Doorbell* doorbell = nullptr;  // tx/rx wake-ups (client/doorbell.h)
-  uint32_t flags = 0;
-  uint32_t signal_count = 0;
-  HandleSignal* sig = nullptr;     // signal_count entries
-  uint8_t* cache_bytes = nullptr;  // the caches' values
-  uint64_t cycle_ns = 0;           // ccomm_set_time(): "now" for reads and writes; 0 = clock
-  bool pending_tx = false;         // CCOMM_OPEN_BATCH: forwarded writes since the last flush
-  uint64_t* pending_dirty = nullptr;  // CCOMM_OPEN_BATCH: their dirty bits, handed to ccommd at
-                                      // the flush only (signal_count bits)
-  uint64_t* pending_states = nullptr; // CCOMM_OPEN_BATCH: state signals with a pending value
-  bool pending_rx = false;         // CCOMM_OPEN_BATCH: any write since the last flush
-};
-
 namespace {
 
 // The public type codes are the store's and the wire's (common/value_type.h).
@@ -79,26 +32,6 @@ static_assert(CCOMM_BOOL == static_cast<int>(ccomm::ValueType::kBool) &&
                   CCOMM_FLOAT == static_cast<int>(ccomm::ValueType::kFloat) &&
                   CCOMM_DOUBLE == static_cast<int>(ccomm::ValueType::kDouble),
               "ccomm_type must match common/value_type.h");
-
-// A signal's change counter: `latest` of a state, `published` of an event ring.
-uint64_t ChangeCounter(const HandleSignal& h) {
-  if (h.flags & st::kSigEvent) return st::RingChangeCount(h.ring);
-  return st::StateChangeCount(h.state);
-}
-
-// Compares every signal's change counter with the last look and remembers the new
-// ones: true if anything was written since. O(signals): ccomm_wait() only.
-bool TakeChanges(ccomm_client* c) {
-  bool changed = false;
-  for (uint32_t i = 0; i < c->signal_count; ++i) {
-    uint64_t v = ChangeCounter(c->sig[i]);
-    if (v != c->sig[i].seen) changed = true;
-    c->sig[i].seen = v;
-  }
-  return changed;
-}
-
-size_t CachedBytes(const SignalDirectoryEntry& d) { return (d.flags & st::kSigEvent) ? 0 : d.value_bytes; }
 
 // Reads a state through the handle's cache (see StateCache). The change words are read
 // before the copy, so the copy is at least as new as they say; if they move during
@@ -158,13 +91,6 @@ bool Retired(const ccomm_client* c) {
   return c->segment.header()->state.load(std::memory_order_relaxed) == st::kRetired;
 }
 
-int MapError(int neg_errno) {
-  if (neg_errno == -ENOENT) return CCOMM_E_NOENT;
-  if (neg_errno == -EPROTO) return CCOMM_E_VERSION;
-  errno = -neg_errno;
-  return CCOMM_E_SYS;
-}
-
 void FillNever(ccomm_info* info) {
   if (!info) return;
   info->status = CCOMM_NEVER;
@@ -174,150 +100,25 @@ void FillNever(ccomm_info* info) {
   info->source_time_ns = 0;
 }
 
+// A signal's change counter: `latest` of a state, `published` of an event ring.
+uint64_t ChangeCounter(const HandleSignal& h) {
+  if (h.flags & st::kSigEvent) return st::RingChangeCount(h.ring);
+  return st::StateChangeCount(h.state);
+}
+
 }  // namespace
 
-const Segment& ccomm::client::SegmentOf(const ccomm_client* c) { return c->segment; }
+bool ccomm::client::TakeChanges(ccomm_client* c) {
+  bool changed = false;
+  for (uint32_t i = 0; i < c->signal_count; ++i) {
+    uint64_t v = ChangeCounter(c->sig[i]);
+    if (v != c->sig[i].seen) changed = true;
+    c->sig[i].seen = v;
+  }
+  return changed;
+}
 
 extern "C" {
-
-int ccomm_open(const char* node, uint32_t flags, ccomm_client** out) {
-  if (!out) return CCOMM_E_INVAL;
-  *out = nullptr;
-  char host[ccomm::store::kNameBytes];
-  if (!node || !*node) node = getenv("CCOMM_NODE");
-  const bool by_hostname = !node || !*node;
-  if (by_hostname) {
-    if (!ccomm::platform::HostName(host, sizeof host)) return CCOMM_E_SYS;
-    node = host;
-  }
-  auto* c = new (std::nothrow) ccomm_client();
-  if (!c) return CCOMM_E_SYS;
-  int r = c->segment.Open(ccomm::store::SegmentName(node));
-  if (r == -ENOENT && by_hostname) {
-    // One image for every board: the hostname need not name the node (ccommd found it
-    // by the board's MAC or IP). The board's only segment is its node's.
-    const std::string prefix = ccomm::store::SegmentName("");
-    char only[ccomm::store::kNameBytes];
-    if (ccomm::platform::ListShm(prefix.c_str() + 1, only, sizeof only) == 1)
-      r = c->segment.Open(ccomm::store::SegmentName(only));
-  }
-  if (r == 0) r = ccomm::client::DoorbellOpen(c->segment, &c->doorbell);
-  if (r != 0) {
-    ccomm::client::DoorbellClose(c->doorbell);
-    delete c;
-    return MapError(r);
-  }
-  c->flags = flags;
-  c->signal_count = c->segment.signal_count();
-  const uint32_t n = c->signal_count;
-  c->sig = new (std::nothrow) HandleSignal[n ? n : 1];
-  size_t cache_total = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    cache_total += CachedBytes(c->segment.dir(i));
-    if (c->segment.safe_value(i)) cache_total += c->segment.dir(i).value_bytes;  // a private copy
-    const SignalDirectoryEntry& d = c->segment.dir(i);
-    if ((flags & CCOMM_OPEN_BATCH) && (d.flags & st::kSigProducedHere) && !(d.flags & st::kSigEvent))
-      cache_total += d.value_bytes;  // the step's pending value
-  }
-  c->cache_bytes = new (std::nothrow) uint8_t[cache_total ? cache_total : 1];
-  c->pending_dirty = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
-  c->pending_states = new (std::nothrow) uint64_t[(n + 63) / 64 + 1]();
-  if (!c->sig || !c->cache_bytes || !c->pending_dirty || !c->pending_states) {
-    ccomm_close(c);
-    return CCOMM_E_SYS;
-  }
-  size_t off = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    const SignalDirectoryEntry& d = c->segment.dir(i);
-    HandleSignal& h = c->sig[i];
-    h.flags = d.flags;
-    h.value_bytes = d.value_bytes;
-    h.count = d.count;
-    h.type = d.type;
-    h.stale_ns = uint64_t{d.stale_after_ms} * 1000000;
-    h.stats = &c->segment.stats(i);
-    if (const uint8_t* safe = c->segment.safe_value(i)) {
-      // Copied at open: the segment is writable by every client, the safe value is not.
-      memcpy(c->cache_bytes + off, safe, d.value_bytes);
-      h.safe_value = c->cache_bytes + off;
-      off += d.value_bytes;
-    }
-    if (d.flags & st::kSigEvent) {
-      h.ring = c->segment.ring(i);
-      ccomm::store::RingSubscribe(h.ring, &h.cursor);
-    } else {
-      h.state = c->segment.state(i);
-      if (d.count == 1 && d.value_bytes == 8) h.read8_type = d.type;
-    }
-    if (size_t k = CachedBytes(d)) {
-      h.cache.value = c->cache_bytes + off;
-      off += k;
-    }
-    if ((flags & CCOMM_OPEN_BATCH) && (d.flags & st::kSigProducedHere) && !(d.flags & st::kSigEvent)) {
-      h.pending = c->cache_bytes + off;
-      off += d.value_bytes;
-    }
-  }
-  TakeChanges(c);  // ccomm_wait() waits for writes after the open
-  ccomm::platform::ProcessId();  // fills the pid cache: the first write makes no syscall
-  *out = c;
-  return 0;
-}
-
-void ccomm_close(ccomm_client* c) {
-  if (!c) return;
-  ccomm::client::DoorbellClose(c->doorbell);
-  delete[] c->sig;
-  delete[] c->cache_bytes;
-  delete[] c->pending_dirty;
-  delete[] c->pending_states;
-  delete c;
-}
-
-const char* ccomm_strerror(int code) {
-  switch (code) {
-    case CCOMM_FRESH: return "fresh";
-    case CCOMM_STALE: return "stale";
-    case CCOMM_NEVER: return "never received";
-    case CCOMM_EMPTY: return "no new event";
-    case CCOMM_E_INVAL: return "invalid argument";
-    case CCOMM_E_NOENT: return "no such signal or segment (is ccommd running for this node?)";
-    case CCOMM_E_TYPE: return "type or length does not match the signal";
-    case CCOMM_E_PERM: return "this node is not the signal's producer";
-    case CCOMM_E_FULL: return "event queue full (ccommd is not forwarding)";
-    case CCOMM_E_BUSY: return "concurrent writers took every slot; retry";
-    case CCOMM_E_SYS: return "operating system error (see errno)";
-    case CCOMM_E_VERSION: return "shared-memory layout version differs from this library";
-    case CCOMM_E_RETIRED: return "segment replaced by a new configuration; reopen";
-    case CCOMM_E_CORRUPT: return "value in shared memory failed its check (segment written over); not returned";
-    default: return "unknown code";
-  }
-}
-
-ccomm_signal ccomm_find(ccomm_client* c, const char* name) {
-  if (!c || !name) return CCOMM_E_INVAL;
-  int id = c->segment.Find(name);
-  return id < 0 ? CCOMM_E_NOENT : id;
-}
-
-int ccomm_signal_count(const ccomm_client* c) { return c ? static_cast<int>(c->signal_count) : CCOMM_E_INVAL; }
-
-const char* ccomm_node_name(const ccomm_client* c) { return c ? c->segment.header()->node_name : nullptr; }
-
-int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
-  if (!Sig(c, s) || !out) return CCOMM_E_INVAL;
-  const SignalDirectoryEntry& d = c->segment.dir(static_cast<uint32_t>(s));
-  out->name = d.name;
-  out->type = d.type;
-  out->count = d.count;
-  out->value_bytes = d.value_bytes;
-  out->is_event = (d.flags & st::kSigEvent) ? 1 : 0;
-  out->produced_here = (d.flags & st::kSigProducedHere) ? 1 : 0;
-  out->consumed_here = (d.flags & st::kSigConsumedHere) ? 1 : 0;
-  out->stale_after_ms = d.stale_after_ms;
-  out->producer = d.producer < c->segment.node_count() ? c->segment.node_name(d.producer) : "";
-  return 0;
-}
 
 namespace {
 
@@ -622,7 +423,7 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
   // misses has seen us waiting and bumps the doorbell, so DoorbellWait returns at once.
   h->rx_waiters.fetch_add(1, std::memory_order_seq_cst);
   uint32_t seen = h->rx_doorbell.load(std::memory_order_seq_cst);
-  bool changed = TakeChanges(c);
+  bool changed = ccomm::client::TakeChanges(c);
   const uint64_t deadline = ccomm::platform::MonotonicNs() + uint64_t(timeout_ms < 0 ? 0 : timeout_ms) * 1000000;
   // Bounded by the deadline; a wake-up for a change another waiter consumed, or a
   // signal, sleeps again.
@@ -635,78 +436,10 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
     }
     ccomm::client::DoorbellWait(c->doorbell, seen, left);
     seen = h->rx_doorbell.load(std::memory_order_seq_cst);
-    changed = TakeChanges(c);
+    changed = ccomm::client::TakeChanges(c);
   }
   h->rx_waiters.fetch_sub(1, std::memory_order_seq_cst);
   return changed ? 1 : 0;
-}
-
-int ccomm_daemon_alive(const ccomm_client* c) {
-  if (!c) return 0;
-  const st::SegmentHeader* h = c->segment.header();
-  if (h->daemon_pid.load(std::memory_order_acquire) == 0) return 0;
-  uint64_t hb = h->daemon_heartbeat_ns.load(std::memory_order_acquire);
-  return ccomm::platform::MonotonicNs() - hb < 1000000000ull ? 1 : 0;
-}
-
-int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out) {
-  const HandleSignal* h = Sig(c, s);
-  if (!h || !out) return CCOMM_E_INVAL;
-  const st::SignalStats& ss = *h->stats;
-  out->writes = ss.writes.load(std::memory_order_relaxed);
-  out->write_errors = ss.write_errors.load(std::memory_order_relaxed);
-  out->tx = ss.tx.load(std::memory_order_relaxed);
-  out->coalesced = ss.coalesced.load(std::memory_order_relaxed);
-  out->rx = ss.rx.load(std::memory_order_relaxed);
-  out->lost = ss.lost.load(std::memory_order_relaxed);
-  out->overflow = ss.overflow.load(std::memory_order_relaxed);
-  out->stale_transitions = ss.stale_transitions.load(std::memory_order_relaxed);
-  out->corrupt = ss.corrupt.load(std::memory_order_relaxed);
-  out->fragments_refused = ss.fragments_refused.load(std::memory_order_relaxed);
-  out->values_incomplete = ss.values_incomplete.load(std::memory_order_relaxed);
-  const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
-  const uint64_t now = ccomm::platform::MonotonicNs();
-  out->last_rx_age_ns = last ? Age(now, last) : -1;
-  out->stale = (h->flags & st::kSigConsumedHere) && h->stale_ns &&
-               (!last || static_cast<uint64_t>(Age(now, last)) > h->stale_ns);
-  return 0;
-}
-
-int ccomm_node_count(const ccomm_client* c) { return c ? static_cast<int>(c->segment.node_count()) : CCOMM_E_INVAL; }
-
-int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out) {
-  if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= c->segment.node_count()) return CCOMM_E_INVAL;
-  const uint32_t n = static_cast<uint32_t>(node);
-  const st::PeerStats& ps = c->segment.peer(n);
-  out->name = c->segment.node_name(n);
-  out->is_self = n == c->segment.node_id();
-  out->alive = ps.alive.load(std::memory_order_relaxed) ? 1 : 0;
-  out->frames_rx = ps.frames_rx.load(std::memory_order_relaxed);
-  out->frames_tx = ps.frames_tx.load(std::memory_order_relaxed);
-  out->frames_lost = ps.frames_lost.load(std::memory_order_relaxed);
-  out->frames_reordered = ps.frames_reordered.load(std::memory_order_relaxed);
-  out->heartbeats_rx = ps.heartbeats_rx.load(std::memory_order_relaxed);
-  out->down_transitions = ps.down_transitions.load(std::memory_order_relaxed);
-  const uint64_t last = ps.last_rx_ns.load(std::memory_order_relaxed);
-  out->last_rx_age_ns = last ? Age(ccomm::platform::MonotonicNs(), last) : -1;
-  return 0;
-}
-
-int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {
-  static const char* const kNames[] = {
-      "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",
-      "frames_unknown_sender", "frames_auth_failed", "frames_replayed", "frames_not_for_us",
-      "entries_unknown_signal", "entries_wrong_type", "send_errors",  "tx_wakeups",
-      "recv_errors",       "slots_reclaimed",    "socket_drops",    "frames_wrong_source"};
-  static_assert(sizeof(kNames) / sizeof(kNames[0]) == st::kDaemonCounterCount, "one name per DaemonCounter");
-  if (!c || index < 0 || static_cast<uint32_t>(index) >= st::kDaemonCounterCount) return CCOMM_E_INVAL;
-  if (name) *name = kNames[index];
-  if (value) *value = c->segment.header()->daemon_counters[index].load(std::memory_order_relaxed);
-  return 0;
-}
-
-uint32_t ccomm_daemon_generation(const ccomm_client* c) {
-  return c ? c->segment.header()->generation.load(std::memory_order_relaxed) : 0;
 }
 
 }  // extern "C"

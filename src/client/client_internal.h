@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// What libccomm's other units (history.cpp) need of a handle, without the handle's
-// definition (client.cpp).
+// What libccomm's other units (history.cpp, client_info.cpp) need of a handle, without the handle's
+// definition (client_handle.h, for the units that build and use it).
 #pragma once
 
 #include "ccomm/ccomm.h"

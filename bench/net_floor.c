@@ -14,7 +14,8 @@
  *           when both ends read the same CLOCK_MONOTONIC (one machine, two netns)
  * ping and source first probe until the other end answers, so start order does not
  * matter. Only libc: this file is also cross-compiled for 32-bit ARM
- * (`cc -O2 -o net_floor net_floor.c` with bench_common.h beside it).
+ * (`cc -O2 -o net_floor net_floor.c` with bench_common.h beside it), which is why all
+ * four roles and both transports stay in this one file.
  */
 #include "bench_common.h"
 

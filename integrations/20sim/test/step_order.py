@@ -22,7 +22,7 @@ first-sample derivative kick for Discrete and a one-sample-early integration oth
 
   step_order.py --work DIR [--cc CC] [--ccomm-include DIR --ccomm-lib DIR]
 
-With --ccomm-include/--ccomm-lib the complete generated task (ccomm_main.c included) is
+With --ccomm-include/--ccomm-lib the complete generated task (ccomm_map.c, ccomm_main.c) is
 also compiled and linked against libccomm, so the matrix model builds as users build it.
 Exit 0 if every check passes.
 """
@@ -140,7 +140,7 @@ def build_trace(cc: str, gen: Path) -> Path:
 
 def build_task(cc: str, gen: Path, include: str, lib: str) -> None:
     run([cc, *CFLAGS, "-I", str(gen), "-I", include, "-o", str(gen / "task"),
-         *[str(gen / f) for f in MODEL_C + ["ccomm_ports.c", "ccomm_main.c"]],
+         *[str(gen / f) for f in MODEL_C + ["ccomm_ports.c", "ccomm_map.c", "ccomm_main.c"]],
          "-L", lib, "-lccomm", "-lm"])
 
 

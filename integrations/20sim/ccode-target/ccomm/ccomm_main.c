@@ -17,6 +17,8 @@
  *
  * Port names: "pos" maps to signal "pos"; "pos[3]" to element 3 (1-based, as in 20-sim)
  * of array signal "pos". --map PORT=SIGNAL and --prefix P change the mapping.
+ * This file: the options, the parameters, the real-time set-up and the loop; the ports'
+ * signals, their reads and writes and the value conversion are in ccomm_map.c.
  */
 #define _GNU_SOURCE
 #include <ccomm/ccomm.h>
@@ -33,46 +35,15 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "ccomm_map.h"
 #include "xxmodel.h"
 #include "xxsubmod.h"
 
-extern const char ccomm_xx_submodel_name[];
-extern const double ccomm_xx_time_step;
-extern const int ccomm_xx_number_inputs;
-extern const int ccomm_xx_number_outputs;
-extern const char* const ccomm_xx_input_names[];
-extern const char* const ccomm_xx_output_names[];
-
-#define MAX_MAPS 256
 #define MAX_PARAMS 256
-#define EVENT_DRAIN_LIMIT 1024 /* bounded: a flooding producer cannot stall the loop */
-
-/* One ccomm signal used by the task; ports refer to it by index. */
-typedef struct {
-  ccomm_signal id;
-  const char* name;
-  int32_t type;
-  uint32_t count;
-  uint32_t value_bytes;
-  int is_event;
-  int is_output;
-  unsigned char* buf;  /* current value (host layout) */
-  unsigned char* last; /* output events: last value sent */
-  int sent_once;
-  int32_t last_status;
-} task_signal;
-
-typedef struct {
-  int signal;       /* index into signals[], -1 = not connected */
-  uint32_t element; /* element in the signal's array */
-} port_map;
 
 static struct {
   const char* node;
-  const char* prefix;
-  const char* map_port[MAX_MAPS];
-  const char* map_signal[MAX_MAPS];
-  int n_maps;
+  ccomm_xx_map_options map; /* --map, --prefix, --ignore-unmapped */
   const char* param_name[MAX_PARAMS];
   double param_value[MAX_PARAMS];
   int n_params;
@@ -80,7 +51,6 @@ static struct {
   int cpu;
   double period;
   double duration;
-  int ignore_unmapped;
   int require_rt;
   int no_mlock;
   int no_doorbell;
@@ -125,187 +95,11 @@ static int check_parameters(void) {
   return ok;
 }
 
-/* ---------------------------------------------------------------- port mapping */
-
-static task_signal signals[512];
-static int n_signals = 0;
-static port_map in_map[XX_NUMBER_INPUTS + 1];
-static port_map out_map[XX_NUMBER_OUTPUTS + 1];
-static int ok_port = -1; /* input index of "ccomm_ok", -1 if the model has none */
-
-/* Splits "name[3]" into base "name" and 0-based element 2; plain names give element 0.
- * Returns 0 for a malformed or 2-D index. */
-static int parse_port(const char* port, char* base, size_t base_len, uint32_t* element,
-                      int* indexed) {
-  const char* br = strchr(port, '[');
-  size_t n = br ? (size_t)(br - port) : strlen(port);
-  if (n == 0 || n >= base_len) return 0;
-  memcpy(base, port, n);
-  base[n] = '\0';
-  *element = 0;
-  *indexed = 0;
-  if (br) {
-    char* end = NULL;
-    long k = strtol(br + 1, &end, 10);
-    if (end == br + 1 || *end != ']' || end[1] != '\0' || k < 1) return 0;
-    *element = (uint32_t)(k - 1);
-    *indexed = 1;
-  }
-  return 1;
-}
-
-static const char* signal_name_for(const char* base, char* scratch, size_t len) {
-  int i;
-  for (i = 0; i < opt.n_maps; i++)
-    if (strcmp(opt.map_port[i], base) == 0) return opt.map_signal[i];
-  if (opt.prefix) {
-    snprintf(scratch, len, "%s%s", opt.prefix, base);
-    return scratch;
-  }
-  return base;
-}
-
-static int add_signal(ccomm_client* c, ccomm_signal id, int is_output) {
-  int i;
-  ccomm_signal_desc d;
-  for (i = 0; i < n_signals; i++) {
-    if (signals[i].id == id) {
-      if (signals[i].is_output != is_output) return -2; /* both input and output */
-      return i;
-    }
-  }
-  if (n_signals == (int)(sizeof signals / sizeof signals[0])) return -1;
-  if (ccomm_describe(c, id, &d) != 0) return -1;
-  task_signal* s = &signals[n_signals];
-  s->id = id;
-  s->name = d.name;
-  s->type = d.type;
-  s->count = d.count;
-  s->value_bytes = d.value_bytes;
-  s->is_event = d.is_event;
-  s->is_output = is_output;
-  s->buf = calloc(1, d.value_bytes);
-  s->last = calloc(1, d.value_bytes);
-  s->sent_once = 0;
-  s->last_status = CCOMM_NEVER;
-  if (!s->buf || !s->last) return -1;
-  return n_signals++;
-}
-
-/* Connects every port; prints every problem, returns 0 if any port cannot be used. */
-static int map_ports(ccomm_client* c) {
-  int i, ok = 1;
-  for (int dir = 0; dir < 2; dir++) {
-    const char* const* names = dir == 0 ? ccomm_xx_input_names : ccomm_xx_output_names;
-    int n = dir == 0 ? ccomm_xx_number_inputs : ccomm_xx_number_outputs;
-    port_map* map = dir == 0 ? in_map : out_map;
-    for (i = 0; i < n; i++) {
-      char base[256], scratch[320];
-      uint32_t element;
-      int indexed;
-      const char* what = dir == 0 ? "input" : "output";
-      map[i].signal = -1;
-      map[i].element = 0;
-      if (dir == 0 && strcmp(names[i], "ccomm_ok") == 0) {
-        ok_port = i;
-        continue;
-      }
-      if (!parse_port(names[i], base, sizeof base, &element, &indexed)) {
-        fprintf(stderr, "%s: %s port '%s': cannot map this name (only 1-D indices)\n",
-                ccomm_xx_submodel_name, what, names[i]);
-        ok = 0;
-        continue;
-      }
-      const char* sname = signal_name_for(base, scratch, sizeof scratch);
-      ccomm_signal id = ccomm_find(c, sname);
-      if (id < 0) {
-        if (opt.ignore_unmapped) {
-          fprintf(stderr, "%s: %s port '%s': no signal '%s', left unconnected\n",
-                  ccomm_xx_submodel_name, what, names[i], sname);
-          continue;
-        }
-        fprintf(stderr, "%s: %s port '%s': no signal '%s' in the configuration of node '%s'\n",
-                ccomm_xx_submodel_name, what, names[i], sname, ccomm_node_name(c));
-        ok = 0;
-        continue;
-      }
-      int si = add_signal(c, id, dir == 1);
-      if (si == -2) {
-        fprintf(stderr, "%s: signal '%s' is connected to both an input and an output\n",
-                ccomm_xx_submodel_name, sname);
-        ok = 0;
-        continue;
-      }
-      if (si < 0) {
-        fprintf(stderr, "%s: cannot use signal '%s'\n", ccomm_xx_submodel_name, sname);
-        ok = 0;
-        continue;
-      }
-      task_signal* s = &signals[si];
-      if (element >= s->count || (!indexed && s->count != 1)) {
-        fprintf(stderr, "%s: %s port '%s': signal '%s' has %u element(s)%s\n",
-                ccomm_xx_submodel_name, what, names[i], sname, (unsigned)s->count,
-                indexed ? "" : "; name the elements as ports 'name[1]'..'name[n]'");
-        ok = 0;
-        continue;
-      }
-      if (dir == 1) {
-        ccomm_signal_desc d;
-        ccomm_describe(c, id, &d);
-        if (!d.produced_here) {
-          fprintf(stderr, "%s: output port '%s': signal '%s' is produced by node '%s', not '%s'\n",
-                  ccomm_xx_submodel_name, names[i], sname, d.producer, ccomm_node_name(c));
-          ok = 0;
-          continue;
-        }
-      }
-      map[i].signal = si;
-      map[i].element = element;
-    }
-  }
-  return ok;
-}
-
-/* ---------------------------------------------------------------- value conversion */
-
-static double element_get(const task_signal* s, uint32_t e) {
-  const unsigned char* p = s->buf;
-  switch (s->type) {
-    case CCOMM_BOOL: return p[e] ? 1.0 : 0.0;
-    case CCOMM_INT32: { int32_t v; memcpy(&v, p + 4 * e, 4); return (double)v; }
-    case CCOMM_UINT32: { uint32_t v; memcpy(&v, p + 4 * e, 4); return (double)v; }
-    case CCOMM_INT64: { int64_t v; memcpy(&v, p + 8 * e, 8); return (double)v; }
-    case CCOMM_FLOAT: { float v; memcpy(&v, p + 4 * e, 4); return (double)v; }
-    case CCOMM_DOUBLE: { double v; memcpy(&v, p + 8 * e, 8); return v; }
-    default: return 0.0;
-  }
-}
-
-/* Rounds to the nearest integer and saturates (NaN gives 0): a controller output never
- * wraps around. */
-static double clampr(double v, double lo, double hi) {
-  if (v != v) return 0.0;
-  v = nearbyint(v);
-  return v < lo ? lo : (v > hi ? hi : v);
-}
-
-static void element_set(task_signal* s, uint32_t e, double v) {
-  unsigned char* p = s->buf;
-  switch (s->type) {
-    case CCOMM_BOOL: p[e] = (v != 0.0 && v == v) ? 1 : 0; break;
-    case CCOMM_INT32: { int32_t x = (int32_t)clampr(v, -2147483648.0, 2147483647.0); memcpy(p + 4 * e, &x, 4); break; }
-    case CCOMM_UINT32: { uint32_t x = (uint32_t)clampr(v, 0.0, 4294967295.0); memcpy(p + 4 * e, &x, 4); break; }
-    case CCOMM_INT64: { int64_t x = (int64_t)clampr(v, -9223372036854775808.0, 9223372036854774784.0); memcpy(p + 8 * e, &x, 8); break; }
-    case CCOMM_FLOAT: { float x = (float)v; memcpy(p + 4 * e, &x, 4); break; }
-    case CCOMM_DOUBLE: memcpy(p + 8 * e, &v, 8); break;
-    default: break;
-  }
-}
-
 /* ---------------------------------------------------------------- statistics */
 
 typedef struct {
-  uint64_t cycles, overruns, missed_releases, stale_cycles, read_errors, write_errors;
+  uint64_t cycles, overruns, missed_releases;
+  ccomm_xx_io_counts io; /* stale_cycles, read_errors, write_errors */
   int64_t max_late_ns, max_exec_ns;
 } task_stats;
 
@@ -325,76 +119,9 @@ static void print_stats(FILE* f) {
           "max_exec_us=%.1f stale_cycles=%llu read_errors=%llu write_errors=%llu\n",
           ccomm_xx_submodel_name, (unsigned long long)stats.cycles,
           (unsigned long long)stats.overruns, (unsigned long long)stats.missed_releases,
-          stats.max_late_ns / 1e3, stats.max_exec_ns / 1e3, (unsigned long long)stats.stale_cycles,
-          (unsigned long long)stats.read_errors, (unsigned long long)stats.write_errors);
+          stats.max_late_ns / 1e3, stats.max_exec_ns / 1e3, (unsigned long long)stats.io.stale_cycles,
+          (unsigned long long)stats.io.read_errors, (unsigned long long)stats.io.write_errors);
   fflush(f);
-}
-
-/* ---------------------------------------------------------------- one period */
-
-/* Returns 0, or a ccomm error that ends the task (segment retired). */
-static int read_inputs(ccomm_client* c, XXDouble* u) {
-  int i, all_fresh = 1;
-  for (i = 0; i < n_signals; i++) {
-    task_signal* s = &signals[i];
-    if (s->is_output) continue;
-    if (s->is_event) {
-      /* Drain the queue: the newest event is the value the model sees; between events
-       * the port holds the last one. */
-      int k;
-      for (k = 0; k < EVENT_DRAIN_LIMIT; k++) {
-        int r = ccomm_read(c, s->id, s->last, s->value_bytes, NULL);
-        if (r == CCOMM_E_RETIRED) return r;
-        if (r < 0) { stats.read_errors++; break; }
-        if (r == CCOMM_EMPTY) break;
-        memcpy(s->buf, s->last, s->value_bytes);
-        s->last_status = CCOMM_FRESH;
-      }
-      continue;
-    }
-    ccomm_info info;
-    int r = ccomm_read(c, s->id, s->buf, s->value_bytes, &info);
-    if (r == CCOMM_E_RETIRED) return r;
-    if (r < 0) {
-      stats.read_errors++;
-      all_fresh = 0;
-      continue;
-    }
-    if (r == CCOMM_NEVER && !(info.flags & CCOMM_INFO_SAFE_VALUE))
-      memset(s->buf, 0, s->value_bytes);
-    s->last_status = r;
-    if (r != CCOMM_FRESH) all_fresh = 0;
-  }
-  for (i = 0; i < ccomm_xx_number_inputs; i++) {
-    if (in_map[i].signal >= 0) u[i] = element_get(&signals[in_map[i].signal], in_map[i].element);
-  }
-  if (ok_port >= 0) u[ok_port] = all_fresh ? 1.0 : 0.0;
-  if (!all_fresh) stats.stale_cycles++;
-  return 0;
-}
-
-static int write_outputs(ccomm_client* c, const XXDouble* y) {
-  int i;
-  for (i = 0; i < ccomm_xx_number_outputs; i++) {
-    if (out_map[i].signal >= 0) element_set(&signals[out_map[i].signal], out_map[i].element, y[i]);
-  }
-  for (i = 0; i < n_signals; i++) {
-    task_signal* s = &signals[i];
-    if (!s->is_output) continue;
-    /* An event output sends a new event only when the value changes. */
-    if (s->is_event && s->sent_once && memcmp(s->buf, s->last, s->value_bytes) == 0) continue;
-    int r = ccomm_write(c, s->id, s->buf, s->value_bytes);
-    if (r == CCOMM_E_RETIRED) return r;
-    if (r < 0) {
-      stats.write_errors++;
-      continue;
-    }
-    if (s->is_event) {
-      memcpy(s->last, s->buf, s->value_bytes);
-      s->sent_once = 1;
-    }
-  }
-  return 0;
 }
 
 /* ---------------------------------------------------------------- set-up */
@@ -439,16 +166,16 @@ static int parse_args(int argc, char** argv) {
     char* eq;
     switch (ch) {
       case 'n': opt.node = optarg; break;
-      case 'x': opt.prefix = optarg; break;
+      case 'x': opt.map.prefix = optarg; break;
       case 'm':
         eq = strchr(optarg, '=');
-        if (!eq || eq == optarg || !eq[1] || opt.n_maps == MAX_MAPS) {
+        if (!eq || eq == optarg || !eq[1] || opt.map.n_maps == CCOMM_XX_MAX_MAPS) {
           fprintf(stderr, "--map wants PORT=SIGNAL, got '%s'\n", optarg);
           return 0;
         }
         *eq = '\0';
-        opt.map_port[opt.n_maps] = optarg;
-        opt.map_signal[opt.n_maps++] = eq + 1;
+        opt.map.map_port[opt.map.n_maps] = optarg;
+        opt.map.map_signal[opt.map.n_maps++] = eq + 1;
         break;
       case 'p': {
         char* end;
@@ -473,7 +200,7 @@ static int parse_args(int argc, char** argv) {
       case 'R': opt.require_rt = 1; break;
       case 'L': opt.no_mlock = 1; break;
       case 'D': opt.no_doorbell = 1; break;
-      case 'u': opt.ignore_unmapped = 1; break;
+      case 'u': opt.map.ignore_unmapped = 1; break;
       case 's': opt.stats_interval = atof(optarg); break;
       case 'h': usage(stdout); exit(0);
       default: usage(stderr); return 0;
@@ -540,7 +267,7 @@ int main(int argc, char** argv) {
             ccomm_strerror(rc));
     return 1;
   }
-  if (!map_ports(c)) {
+  if (!ccomm_xx_map_ports(c, &opt.map)) {
     ccomm_close(c);
     return 1;
   }
@@ -561,7 +288,7 @@ int main(int argc, char** argv) {
   uint64_t k = 0;
 
   /* Initial outputs: the model's values for the inputs as they are now. */
-  if (read_inputs(c, u) != 0 || (%FUNCTIONPREFIX%InitializeSubmodel(u, y, 0.0), write_outputs(c, y) != 0)) {
+  if (ccomm_xx_read_inputs(c, u, &stats.io) != 0 || (%FUNCTIONPREFIX%InitializeSubmodel(u, y, 0.0), ccomm_xx_write_outputs(c, y, &stats.io) != 0)) {
     fprintf(stderr, "%s: ccommd replaced the segment during start-up\n", ccomm_xx_submodel_name);
     ccomm_close(c);
     return 3;
@@ -585,10 +312,10 @@ int main(int argc, char** argv) {
      * reading per step instead of one per signal access. */
     ccomm_set_time(c, wake_ns);
 
-    if (read_inputs(c, u) != 0) { exit_code = 3; break; }
+    if (ccomm_xx_read_inputs(c, u, &stats.io) != 0) { exit_code = 3; break; }
     %FUNCTIONPREFIX%CalculateSubmodel(u, y, (XXDouble)k * step);
     k++;
-    if (write_outputs(c, y) != 0) { exit_code = 3; break; }
+    if (ccomm_xx_write_outputs(c, y, &stats.io) != 0) { exit_code = 3; break; }
     stats.cycles++;
 
     clock_gettime(CLOCK_MONOTONIC, &now);
@@ -613,7 +340,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "%s: ccommd replaced the segment (new configuration); stopping\n", ccomm_xx_submodel_name);
 
   %FUNCTIONPREFIX%TerminateSubmodel(u, y, (XXDouble)k * step);
-  if (exit_code == 0) write_outputs(c, y);
+  if (exit_code == 0) ccomm_xx_write_outputs(c, y, &stats.io);
   print_stats(stdout);
   ccomm_close(c);
   return exit_code;

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The ports of submodel %SUBMODEL_NAME% in 20-sim's order (the order of u[] and y[]).
- * ccomm_main.c connects each port to the ccomm signal of the same name.
+ * ccomm_map.c connects each port to the ccomm signal of the same name.
  */
 #include <stddef.h>
 

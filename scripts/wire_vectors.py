@@ -206,7 +206,7 @@ def vectors():
     recs = [(1, 1, 0x00, 1000000, 0, 1), (4, 2, 0x01, 0, 3, 250)]
     summ = lambda records=recs, **bad: Summary(0, 1, 1000, 5000000000, 0x3, counters, records, **bad)
     return [
-        # Valid frames (expect=ok). wire_test.cpp encodes the same contents.
+        # Valid frames (expect=ok). src/wire/wire_test_util.h (ValidVectors) encodes the same contents.
         Frame("heartbeat", "ok", note="(a) heartbeat from node 2 to every node", **hb),
         Frame("double", "ok", entries=[dbl()], note="(b) one `double` state entry, node 1 to node 2", **d),
         Frame("setup", "ok", entries=[

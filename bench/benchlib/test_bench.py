@@ -11,7 +11,7 @@ import subprocess
 import tempfile
 import unittest
 
-from . import ccomm, procs, report, results, suite
+from . import callgrind, ccomm, procs, report, results, suite
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -68,10 +68,10 @@ class CallgrindTest(unittest.TestCase):
         with tempfile.NamedTemporaryFile("w", suffix=".cg") as f:
             f.write(text)
             f.flush()
-            calls = ccomm.callgrind_calls(f.name)
-            self.assertEqual(ccomm.callgrind_total(f.name), 555)
+            calls = callgrind.inclusive_calls(f.name)
+            self.assertEqual(callgrind.total_ir(f.name), 555)
         self.assertEqual(calls["ccomm::Daemon::HandleFrame(unsigned char const*)"], [4, 450])
-        self.assertEqual(ccomm.per_call(calls, [("rx", "HandleFrame(")]), [("rx", 4, 112.5)])
+        self.assertEqual(callgrind.per_call(calls, [("rx", "HandleFrame(")]), [("rx", 4, 112.5)])
 
 
 class MergeTest(unittest.TestCase):

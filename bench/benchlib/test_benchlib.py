@@ -16,7 +16,7 @@ import tempfile
 import time
 import unittest
 
-from . import procs, report, results
+from . import formatting, procs, results, targets
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -115,7 +115,7 @@ class PairedRatioTest(unittest.TestCase):
         c = self.row("ccomm_raw_oneway_block_1khz_p8", [55000, 55000, 55000, 150000])
         f = self.row("net_raw_oneway_1khz_p8", [50000, 50000, 50000, 50000])
         c["p50_ns"], f["p50_ns"] = 70000, 50000
-        ck = [k for k in report.checks(report.Rows([c, f]), {})
+        ck = [k for k in targets.checks(formatting.Rows([c, f]), {})
               if k["text"].startswith("board->board raw one-way, 8 B")][0]
         self.assertEqual(ck["status"], "met")
         self.assertIn("median **1.10x**", ck["detail"])
@@ -123,7 +123,7 @@ class PairedRatioTest(unittest.TestCase):
     def test_all_alternations_over_is_missed(self):
         c = self.row("ccomm_raw_oneway_block_1khz_p8", [70000, 72000, 68000, 71000])
         f = self.row("net_raw_oneway_1khz_p8", [50000, 50000, 50000, 50000])
-        ck = [k for k in report.checks(report.Rows([c, f]), {})
+        ck = [k for k in targets.checks(formatting.Rows([c, f]), {})
               if k["text"].startswith("board->board raw one-way, 8 B")][0]
         self.assertEqual(ck["status"], "MISSED")
 
@@ -133,13 +133,13 @@ class PairedRatioTest(unittest.TestCase):
         # halves around it 1.1x.
         c = self.row("ccomm_raw_oneway_block_1khz_p8", [49500, 60500, 71500, 82500])
         f = self.row("net_raw_oneway_1khz_p8", [40000, 50000, 60000, 70000, 80000])
-        self.assertEqual([round(x, 3) for x in report._paired_ratios(c, f)], [1.1, 1.1, 1.1, 1.1])
-        self.assertEqual([round(x, 3) for x in report._paired_ratios(c, dict(f, rep_p50_ns=f["rep_p50_ns"][:4]))],
+        self.assertEqual([round(x, 3) for x in formatting.paired_ratios(c, f)], [1.1, 1.1, 1.1, 1.1])
+        self.assertEqual([round(x, 3) for x in formatting.paired_ratios(c, dict(f, rep_p50_ns=f["rep_p50_ns"][:4]))],
                          [1.238, 1.21, 1.192, 1.179])
 
     def test_unpaired_rows_fall_back_to_pooled(self):
-        self.assertEqual(report._paired_ratios({"rep_p50_ns": [1, 2]}, {"rep_p50_ns": [1]}), [])
-        self.assertEqual(report._median([3.0, 1.0, 2.0, 10.0]), 2.5)
+        self.assertEqual(formatting.paired_ratios({"rep_p50_ns": [1, 2]}, {"rep_p50_ns": [1]}), [])
+        self.assertEqual(formatting.median([3.0, 1.0, 2.0, 10.0]), 2.5)
 
 
 class ProgramTest(unittest.TestCase):

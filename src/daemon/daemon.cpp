@@ -107,6 +107,13 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
   int gid = -1;
   if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
+  // Two ccommd for one node would both forward and reclaim in one segment: refuse the
+  // second (a systemd unit and a hand-started one, say) before it touches anything.
+  if (const int other = RunningDaemonOf(store::SegmentName(self.name))) {
+    *error = "a ccommd for node '" + self.name + "' is already running (pid " + std::to_string(other) +
+             "): stop it first (systemctl stop ccommd)";
+    return -EBUSY;
+  }
   int r = CreateOrAdoptSegment(&segment_, cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
@@ -221,6 +228,7 @@ void Daemon::RequestStop() {
 void Daemon::Shutdown() {
   running_.store(false);
   transport_.Close();
+  view_.Stop();
   if (segment_.is_open()) {
     segment_.header()->daemon_pid.store(0, std::memory_order_release);
     segment_.Close();  // the segment stays: clients keep reading (stale) values

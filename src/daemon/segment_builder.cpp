@@ -3,9 +3,12 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <new>
 #include <vector>
+
+#include "common/platform.h"
 
 namespace ccomm {
 
@@ -123,6 +126,20 @@ void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t s
     off += DataBytes(s, history);
   }
   h->state.store(kInitializing, std::memory_order_relaxed);
+}
+
+int RunningDaemonOf(const std::string& name) {
+  store::Segment existing;
+  if (existing.Open(name) != 0) return 0;  // none, or another layout: CreateOrAdopt decides
+  const store::SegmentHeader* h = existing.header();
+  const int pid = h->daemon_pid.load(std::memory_order_acquire);
+  if (pid <= 0 || pid == getpid()) return 0;
+  const uint64_t first = h->daemon_heartbeat_ns.load(std::memory_order_acquire);
+  for (int i = 0; i < 20; ++i) {  // its supervision tick stamps every 10 ms
+    platform::SleepNs(5000000);
+    if (h->daemon_heartbeat_ns.load(std::memory_order_acquire) != first) return pid;
+  }
+  return 0;
 }
 
 int CreateOrAdoptSegment(store::Segment* segment, const SystemConfig& cfg, uint32_t node_id,

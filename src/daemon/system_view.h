@@ -32,6 +32,10 @@ class SystemView {
   /// view then holds this node only). 0 or -errno with `error`.
   int Start(const SystemConfig& cfg, uint32_t self, TransportKind kind, bool force_udp, store::Segment* segment,
             Transport* transport, const auth::FrameAuth* auth, int gid, std::string* error);
+  /// Clean stop: the view's name goes with the daemon (`ccomm stats --all` then says no
+  /// ccommd is running; a tool that mapped it keeps its copy). A killed ccommd leaves it,
+  /// and its next start replaces it.
+  void Stop() { view_.Remove(); }
   /// Supervision tick: sends the next summary part when it is due, refreshes this node's
   /// record. Returns the number of frames sent (tests count them).
   uint32_t Tick(uint64_t now);

@@ -62,6 +62,7 @@ int View::Create(const std::string& name, uint32_t nodes, uint32_t signals, uint
   platform::CloseFd(fd);
   base_ = p;
   size_ = size;
+  created_name_ = name;
   // ftruncate zeroed it: every counter and word starts at 0, every seq even.
   ViewHeader* h = mutable_header();
   h->magic = kViewMagic;
@@ -102,6 +103,12 @@ int View::OpenReadOnly(const std::string& name) {
   base_ = p;
   size_ = size;
   return 0;
+}
+
+void View::Remove() {
+  if (created_name_.empty()) return;
+  platform::ShmUnlink(created_name_.c_str());
+  created_name_.clear();
 }
 
 void View::Close() {

@@ -92,6 +92,9 @@ class View {
   /// version, or not initialised yet).
   int OpenReadOnly(const std::string& name);
   void Close();
+  /// ccommd at a clean stop: removes the name Create gave the object (readers that mapped
+  /// it keep their mapping). Nothing if this object did not create one.
+  void Remove();
   bool is_open() const { return base_ != nullptr; }
 
   const ViewHeader* header() const { return static_cast<const ViewHeader*>(base_); }
@@ -118,6 +121,7 @@ class View {
   ViewRow* Row(uint32_t n, uint32_t s) const;
   void* base_ = nullptr;
   size_t size_ = 0;
+  std::string created_name_;  // set by Create: the name Remove() removes
 };
 
 }  // namespace store

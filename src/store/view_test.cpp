@@ -103,11 +103,14 @@ TEST(View, SeqlockGivesConsistentCopies) {
     }
   });
   uint64_t last = 0, copies = 0, mixed = 0;
-  // At least 300 ms, and on until some copies got through (a loaded 2-CPU machine can
-  // starve the reader for a while: the test is about mixtures, not speed), at most 10 s.
+  // At least 300 ms, and on until some copies of the writer's values got through (a
+  // loaded 2-CPU machine can starve the reader, or the writer thread before its first
+  // write: CI once saw only the initial zeros in 300 ms; the test is about mixtures, not
+  // speed), at most 10 s.
   const auto start = std::chrono::steady_clock::now();
   const auto until = start + std::chrono::milliseconds(300), give_up = start + std::chrono::seconds(10);
-  for (auto now = start; now < until || (copies < 100 && now < give_up); now = std::chrono::steady_clock::now()) {
+  for (auto now = start; now < until || ((copies < 100 || last == 0) && now < give_up);
+       now = std::chrono::steady_clock::now()) {
     ViewNodeCopy n;
     if (r.ReadNode(1, &n)) {
       ++copies;

@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """Faults from the core issue: a writer killed mid-stream, ccommd stopped under running
-apps, the link cut. Figures (detection times) are printed with -s."""
+apps, the link cut; and an operator's second ccommd for a running node. Figures (detection times) are printed with -s."""
+import json
 import os
 import signal
 import time
 
-from harness import SANITIZED, NodePair, peer_stats, signal_stats, wait_for
+from harness import BIN, SANITIZED, NodePair, peer_stats, signal_stats, run, wait_for
 
 STALE_MS = 20  # dist/signals.xml: stale_after_ms of every signal
 
@@ -92,3 +93,32 @@ def test_link_down_goes_stale_and_recovers():
               "frames lost while down: %d" % (stale * 1000, peer_down * 1000, fresh * 1000, lost))
         assert lost > 0  # frames sent during the outage are counted as lost
         assert time.time() - t_down < 15
+
+
+def test_second_ccommd_for_a_node_is_refused_and_a_clean_stop_removes_the_view():
+    """A second ccommd for a running node (a hand-started one next to the unit) is refused
+    before it touches the segment or the system view; the running one carries on. A clean
+    stop removes the node's system view (the segment stays for the apps)."""
+    with NodePair() as pair:
+        pair.start("control")
+        pair.start("planner")
+        pair.spawn("control", "pub", "wheel0_pos", "4.5", "--rate", "200", "--count", "100000")
+        assert wait_for(lambda: pair.echo_once("planner", "wheel0_pos") == ("4.5", "fresh"), 3)
+        first = pair.daemons["planner"].pid
+        t0 = time.time()
+        second = run(pair.exec_prefix("planner") + [os.path.join(BIN, "ccommd"), "--node", "planner", "--no-rt",
+                                                    "-c", pair.config], check=False, env=pair.env, timeout=10)
+        took = time.time() - t0
+        assert second.returncode != 0, second.stdout + second.stderr
+        assert "already running (pid %d)" % first in second.stdout + second.stderr, second.stdout + second.stderr
+        assert pair.daemons["planner"].poll() is None
+        assert wait_for(lambda: pair.echo_once("planner", "wheel0_pos") == ("4.5", "fresh"), 1)
+        assert pair.stats("planner")["daemon_alive"]
+        assert json.loads(pair.cli("planner", "stats", "--all", "--json").stdout)["node"] == "planner"
+        shm = "/dev/shm/" + pair.env["CCOMM_SHM_PREFIX"].lstrip("/") + "planner"
+        assert os.path.exists(shm) and os.path.exists(shm + ".view")
+        assert pair.stop("planner") == 0
+        assert os.path.exists(shm) and not os.path.exists(shm + ".view")
+        gone = pair.cli("planner", "stats", "--all", check=False)
+        assert gone.returncode != 0 and "no system view" in gone.stderr, gone.stdout + gone.stderr
+        print("\nsecond ccommd refused in %.0f ms: %s" % (took * 1000, (second.stdout + second.stderr).strip()))

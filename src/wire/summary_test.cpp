@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "wire/wire_test_util.h"
+
 #ifndef CCOMM_SOURCE_DIR
 #error "CCOMM_SOURCE_DIR must point at the source tree (set by src/wire/CMakeLists.txt)"
 #endif
@@ -20,14 +22,6 @@
 namespace ccomm {
 namespace wire {
 namespace {
-
-using Bytes = std::vector<uint8_t>;
-
-DecodeError DecodeExact(const Bytes& data, FrameHeader* h) {
-  std::unique_ptr<uint8_t[]> buf(new uint8_t[data.size() ? data.size() : 1]);
-  if (!data.empty()) std::memcpy(buf.get(), data.data(), data.size());
-  return DecodeHeader(data.empty() ? nullptr : buf.get(), data.size(), h);
-}
 
 // name -> (expect, bytes) of every ```hex block whose frame has the summary flag.
 std::map<std::string, std::pair<std::string, Bytes>> SummaryVectors() {
@@ -74,15 +68,9 @@ struct SummaryDef {
   std::vector<SummaryRecord> records;
 };
 
-FrameHeader Header(uint16_t sender, uint16_t dest, uint32_t seq, uint64_t t) {
-  FrameHeader h;
-  h.flags = kFlagSummary;
-  h.sender = sender;
-  h.dest = dest;
-  h.config_hash = 0x1234ABCD;
-  h.seq = seq;
-  h.send_time_ns = t;
-  return h;
+// A summary frame's header (wire_test_util.h's Header with the summary flag).
+FrameHeader SummaryHeader(uint16_t sender, uint16_t dest, uint32_t seq, uint64_t t) {
+  return Header(kFlagSummary, sender, seq, t, dest);
 }
 
 // The contents of the valid summary vectors; scripts/wire_vectors.py defines the same.
@@ -99,14 +87,14 @@ std::map<std::string, SummaryDef> ValidSummaries() {
   a.frames_bad = 1;
   a.frames_lost = 2;
   a.socket_drops = 0;
-  v["summary"] = {Header(2, 0, 3, 6000000000), a,
+  v["summary"] = {SummaryHeader(2, 0, 3, 6000000000), a,
                   {{1, kRoleProduced, 0, 1000000, 0, 1}, {4, kRoleConsumed, kRecordStale, 0, 3, 250}}};
   SummaryHead b;
   b.part = 1;
   b.parts = 2;
   b.cycle_ms = 400;
   b.uptime_ns = 9000000000;
-  v["summary-empty-part"] = {Header(5, kDestAll, 0, 7000000000), b, {}};
+  v["summary-empty-part"] = {SummaryHeader(5, kDestAll, 0, 7000000000), b, {}};
   return v;
 }
 
@@ -175,15 +163,15 @@ TEST(SummaryWriter, RefusesWhatTheDecoderWouldRefuse) {
   uint8_t buf[kMaxFrameSize];
   SummaryWriter w(buf, sizeof buf);
   SummaryHead head;
-  FrameHeader data = Header(1, 0, 0, 1);
+  FrameHeader data = SummaryHeader(1, 0, 0, 1);
   data.flags = 0;
   EXPECT_FALSE(w.Begin(data, head)) << "not a summary frame";
   EXPECT_EQ(w.Finish(), 0u);
   head.part = 1;
   head.parts = 1;
-  EXPECT_FALSE(w.Begin(Header(1, 0, 0, 1), head)) << "part out of range";
+  EXPECT_FALSE(w.Begin(SummaryHeader(1, 0, 0, 1), head)) << "part out of range";
   head.part = 0;
-  ASSERT_TRUE(w.Begin(Header(1, 0, 0, 1), head));
+  ASSERT_TRUE(w.Begin(SummaryHeader(1, 0, 0, 1), head));
   EXPECT_TRUE(w.Add({5, kRoleProduced, 0, 0, 0, 0}));
   EXPECT_FALSE(w.Add({5, kRoleConsumed, 0, 0, 0, 0})) << "signal ids must increase";
   EXPECT_FALSE(w.Add({3, kRoleConsumed, 0, 0, 0, 0})) << "signal ids must increase";
@@ -196,7 +184,7 @@ TEST(SummaryWriter, RefusesWhatTheDecoderWouldRefuse) {
   EXPECT_EQ(DecodeHeader(buf, n, &h), DecodeError::kOk);
   // A summary frame takes no data entries.
   FrameWriter fw(buf, sizeof buf);
-  fw.Begin(Header(1, 0, 0, 1));
+  fw.Begin(SummaryHeader(1, 0, 0, 1));
   const double v = 1;
   EXPECT_FALSE(fw.Add(1, 6, 0, 1, 1, 1, &v, sizeof v));
   EXPECT_EQ(fw.Finish(), 0u) << "a summary without a body is not a frame";
@@ -205,7 +193,7 @@ TEST(SummaryWriter, RefusesWhatTheDecoderWouldRefuse) {
 TEST(SummaryWriter, FullPartFitsWithAuthTag) {
   uint8_t buf[kMaxFrameSize];
   SummaryWriter w(buf, sizeof buf);
-  FrameHeader fh = Header(1, 0, 0, 1);
+  FrameHeader fh = SummaryHeader(1, 0, 0, 1);
   fh.flags |= kFlagAuth;
   ASSERT_TRUE(w.Begin(fh, SummaryHead()));
   for (uint16_t i = 0; i < kSummaryMaxRecords; ++i) ASSERT_TRUE(w.Add({i, kRoleConsumed, kRecordNever, 0, 0, kSummaryNoAge}));

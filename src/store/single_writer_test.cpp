@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "testing/run_until.h"
+
 namespace ccomm {
 namespace store {
 namespace {
@@ -117,7 +119,7 @@ TEST_P(SingleWriterConcurrent, ReadersNeverSeeTornOrOlderValues) {
       }
     });
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  test_threads::SleepUntilEnough(std::chrono::milliseconds(300), [&] { return reads.load() > 100; });
   stop = true;
   for (auto& t : threads) t.join();
   EXPECT_EQ(torn.load(), 0);

@@ -101,6 +101,12 @@ int Segment::Open(const std::string& name) {
   platform::CloseFd(fd);
   if (r != 0) return r;
   auto* h = static_cast<SegmentHeader*>(p);
+  if (h->state.load(std::memory_order_acquire) == kRetired) {
+    // Opened just before ccommd unlinked it: the replacement is on its way. Checked before
+    // the magic, which a damaged segment (the reason it is being replaced) may not have.
+    platform::Unmap(p, size);
+    return -ENOENT;
+  }
   if (h->magic == 0) {
     // ccommd is creating it: ftruncate zero-fills, the header is copied in next. Not a
     // foreign segment; a client retrying now must not give up with "version mismatch".
@@ -199,10 +205,14 @@ std::string CheckLayout(const void* base, size_t size) {
   return "";
 }
 
-// An existing segment that failed its layout check (a client wrote over it, or another
-// version made it): clients still attached must reopen, so mark it retired anyway.
-static void RetireDamaged(const std::string& name) {
+// Replacing a segment, in this order: the name first stops pointing at the old object,
+// then the old object says "retired". A client told to reopen by that word then finds the
+// new segment or nothing yet (-ENOENT: it waits), never the old one: for a damaged old
+// segment that would be -EPROTO ("layout version differs") and the client would give up.
+// Clients still attached keep their mapping of the unlinked object until they reopen.
+static void UnlinkThenRetire(const std::string& name) {
   int fd = platform::ShmOpen(name.c_str(), false, 0);
+  platform::ShmUnlink(name.c_str());  // also removes a half-created or foreign segment
   if (fd < 0) return;
   size_t size = 0;
   void* p = platform::FileSize(fd, &size) == 0 && size >= sizeof(SegmentHeader) ? platform::MapShared(fd, size) : nullptr;
@@ -253,13 +263,9 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
     *adopted = true;
     return 0;
   }
-  if (r == 0) {
-    // Different configuration: tell clients to reopen, then replace it.
-    old.header()->state.store(kRetired, std::memory_order_release);
-    old.Close();
-  }
-  if (r == -EPROTO) RetireDamaged(name);
-  platform::ShmUnlink(name.c_str());  // also removes a half-created or foreign segment
+  // A different configuration, a damaged or foreign segment, or none: replace it.
+  old.Close();
+  UnlinkThenRetire(name);
   int fd = platform::ShmOpen(name.c_str(), true, 0660);
   if (fd < 0) {
     *error = "cannot create shared memory " + name + ": " + strerror(-fd);

@@ -34,7 +34,8 @@ class Segment {
                     std::string* error);
 
   /// Client side: maps an existing, ready segment. Returns 0, -ENOENT (no segment or
-  /// not ready yet), -EPROTO (bad magic/layout version/size) or another -errno.
+  /// not ready yet, or retired: being replaced), -EPROTO (bad magic/layout version/size)
+  /// or another -errno.
   int Open(const std::string& name);
 
   void Close();

@@ -10,6 +10,9 @@
 #include "common/platform.h"
 #include "store/reclaim.h"
 #include <sys/wait.h>
+
+#include <atomic>
+#include <thread>
 #include <unistd.h>
 #include "daemon/segment_builder.h"
 #include "testing/test_config.h"
@@ -122,6 +125,42 @@ TEST_F(SegmentTest, ConfigChangeRetiresOldSegment) {
   Segment fresh;
   ASSERT_EQ(fresh.Open(SegmentName("a")), 0);
   EXPECT_EQ(fresh.dir(1).count, 4u);
+}
+
+// A client that sees its damaged segment retired and reopens at once must find the
+// replacement or nothing yet (-ENOENT: wait), never the damaged one (-EPROTO: "layout
+// version differs", which made a fresh-machine CI run's writer give up). The observer
+// reopens the moment the old mapping says retired; repeated because the window it
+// probes is a few microseconds wide.
+TEST_F(SegmentTest, ClientReopeningDuringReplacementOfADamagedSegmentNeverSeesIt) {
+  int saw_damaged = 0;
+  const int rounds = 2000;
+  for (int round = 0; round < rounds; ++round) {
+    platform::ShmUnlink(SegmentName("a").c_str());
+    Segment first, attached;
+    std::string err;
+    bool adopted;
+    ASSERT_EQ(CreateOrAdoptSegment(&first, Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+    ASSERT_EQ(attached.Open(SegmentName("a")), 0);
+    first.header()->magic = 0xdeadbeef;  // garbage over the header: the next ccommd must replace it
+    first.Close();
+    std::atomic<int> reopen{1};
+    std::thread client([&] {
+      while (attached.header()->state.load(std::memory_order_acquire) != kRetired) {
+      }
+      Segment again;
+      int r;
+      while ((r = again.Open(SegmentName("a"))) == -ENOENT) {
+      }
+      reopen = r;
+    });
+    Segment second;
+    ASSERT_EQ(CreateOrAdoptSegment(&second, Cfg(), 0, SegmentName("a"), -1, &adopted, &err), 0) << err;
+    client.join();
+    EXPECT_TRUE(reopen == 0 || reopen == -EPROTO) << reopen;
+    if (reopen == -EPROTO) ++saw_damaged;
+  }
+  EXPECT_EQ(saw_damaged, 0) << "of " << rounds << " reopens";
 }
 
 TEST_F(SegmentTest, OpenMissingOrForeignSegment) {

@@ -100,6 +100,17 @@ spawn() {
   PIDS+=($!)
 }
 
+# wait_for SECONDS COMMAND...: true as soon as COMMAND succeeds (polled every 0.1 s),
+# false after SECONDS. For "it happens eventually" checks on a slow, loaded machine.
+wait_for() {
+  local limit=$1 start=$SECONDS
+  shift
+  until "$@"; do
+    [ $((SECONDS - start)) -ge "$limit" ] && return 1
+    sleep 0.1
+  done
+}
+
 # ---- namespaces ---------------------------------------------------------------------
 ns_new() {  # ns_new NAME: a namespace with lo up and IPv6 off (no stray ND/MLD frames)
   ip netns add "$1" || { echo "Bail out! ip netns add $1"; exit 1; }

@@ -57,6 +57,25 @@ if [ "$rc" = 1 ] && grep -q "connected to both an input and an output" "$out/e3"
   echo "PASS signal used as input and output refused"
 else echo "FAIL input/output clash: exit $rc: $(cat "$out/e3")"; fail=1; fi
 
+echo "== 20-sim C-code target: a period other than the model's step size"
+rc=0
+# PDController's step size is 2 ms: at 4 ms one second of real time would be half a second of model time.
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 0.2 --period 0.004 >/dev/null 2>"$out/p1" || rc=$?
+if [ "$rc" = 1 ] && grep -q "differs from the model's step size 0.002 s" "$out/p1" && grep -q "0.5 x real time" "$out/p1"; then
+  echo "PASS period mismatch refused: $(head -1 "$out/p1")"
+else echo "FAIL period mismatch: exit $rc: $(cat "$out/p1")"; fail=1; fi
+rc=0
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 0.2 --period 0.004 --allow-time-scaling \
+  >/dev/null 2>"$out/p2" || rc=$?
+if [ "$rc" = 0 ] && grep -q "model time runs at 0.5 x real time" "$out/p2"; then
+  echo "PASS --allow-time-scaling runs and says so"
+else echo "FAIL --allow-time-scaling: exit $rc: $(cat "$out/p2")"; fail=1; fi
+rc=0
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 0.2 --period 2ms >/dev/null 2>"$out/p3" || rc=$?
+if [ "$rc" = 1 ] && grep -q "wants a number of seconds, got '2ms'" "$out/p3"; then
+  echo "PASS --period 2ms refused"
+else echo "FAIL --period 2ms: exit $rc: $(cat "$out/p3")"; fail=1; fi
+
 echo "== 20-sim C-code target: vector ports and an event input (VectorGain)"
 it_bg "$ibin/ccomm_20sim_vectorgain" --node ctrl --priority 20 >"$out/vg.out" 2>"$out/vg.err"
 vg=$IT_PID
@@ -163,6 +182,17 @@ if CCOMM_NODE=ctrl CCOMM_GEN_20SIM4C="$here/4c/gen_4c.py" "$bin/ccomm" gen 20sim
    grep -q '#define CCOMM4C_NODE "ctrl"' "$out/gcli/ccomm_4c.h"; then
   echo "PASS ccomm gen 20sim4c runs the generator"
 else echo "FAIL ccomm gen 20sim4c"; fail=1; fi
+
+echo "== 20-sim C-code target: started while ccommd is down"
+# A clean stop leaves the segment for the next ccommd to adopt; a task must not take it
+# for a running system and run on safe values in silence.
+it_stop "${_it_pids[0]}"
+rc=0
+"$ibin/ccomm_20sim_pdcontroller" --node ctrl --priority 0 --duration 1 --wait-ccommd 0.5 >"$out/d1.out" 2>"$out/d1" || rc=$?
+if [ "$rc" = 1 ] && grep -q "no ccommd is running for node ctrl (its segment exists but its heartbeat has stopped" "$out/d1" &&
+   ! grep -q "cycles=" "$out/d1.out"; then
+  echo "PASS task refused without a running ccommd: $(head -1 "$out/d1")"
+else echo "FAIL task without ccommd: exit $rc: $(cat "$out/d1" "$out/d1.out")"; fail=1; fi
 
 if [ "$fail" = 0 ]; then echo "20-sim integration: all checks passed"; else echo "20-sim integration: FAILED"; fi
 exit "$fail"

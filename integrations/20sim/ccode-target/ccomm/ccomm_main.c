@@ -50,6 +50,8 @@ static struct {
   int priority;
   int cpu;
   double period;
+  int allow_time_scaling; /* --allow-time-scaling: run with a period other than the step size */
+  double wait_ccommd;     /* --wait-ccommd: how long start-up waits for a running ccommd */
   double duration;
   int require_rt;
   int no_mlock;
@@ -134,7 +136,12 @@ static void usage(FILE* f) {
           "  --map PORT=SIGNAL   connect a port to a differently named signal (repeatable)\n"
           "  --prefix P          connect port X to signal PX\n"
           "  --param NAME=VALUE  override a model parameter (repeatable)\n"
-          "  --period SECONDS    task period (default: the 20-sim step size, %g s)\n"
+          "  --period SECONDS    task period (default and normally: the 20-sim step size, %g s;\n"
+          "                      another period is refused: the model would run faster or\n"
+          "                      slower than real time)\n"
+          "  --allow-time-scaling  accept a --period other than the step size on purpose; the\n"
+          "                      task says how fast model time then runs\n"
+          "  --wait-ccommd S     wait up to S seconds for ccommd at start-up (default 5)\n"
           "  --duration SECONDS  stop after this time (default: run until SIGINT/SIGTERM)\n"
           "  --priority N        SCHED_FIFO priority, 0 = normal scheduling (default 80)\n"
           "  --cpu N             pin the task to CPU N\n"
@@ -143,9 +150,22 @@ static void usage(FILE* f) {
           "  --no-doorbell       writes never make a syscall (CCOMM_OPEN_NO_DOORBELL)\n"
           "  --ignore-unmapped   leave ports without a signal unconnected instead of failing\n"
           "  --stats-interval S  print timing statistics every S seconds\n"
-          "Inputs: %d, outputs: %d. Exit: 0 stopped, 1 set-up failed, 3 segment replaced.\n",
+          "Inputs: %d, outputs: %d. Exit: 0 stopped, 1 set-up failed (also: no ccommd running),\n"
+          "3 segment replaced.\n",
           ccomm_xx_submodel_name, ccomm_xx_submodel_name, ccomm_xx_time_step, ccomm_xx_number_inputs,
           ccomm_xx_number_outputs);
+}
+
+/* A positive number of seconds, the whole argument (atof took "2ms" as 2 s). */
+static int parse_seconds(const char* what, const char* text, double* out) {
+  char* end;
+  double v = strtod(text, &end);
+  if (end == text || *end || !(v >= 0.0) || v > 1e6) {
+    fprintf(stderr, "%s wants a number of seconds, got '%s'\n", what, text);
+    return 0;
+  }
+  *out = v;
+  return 1;
 }
 
 static int parse_args(int argc, char** argv) {
@@ -157,11 +177,13 @@ static int parse_args(int argc, char** argv) {
       {"require-rt", no_argument, 0, 'R'},       {"no-mlock", no_argument, 0, 'L'},
       {"no-doorbell", no_argument, 0, 'D'},      {"ignore-unmapped", no_argument, 0, 'u'},
       {"stats-interval", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
+      {"allow-time-scaling", no_argument, 0, 'S'}, {"wait-ccommd", required_argument, 0, 'W'},
       {0, 0, 0, 0}};
   int ch;
   opt.priority = 80;
   opt.cpu = -1;
   opt.period = ccomm_xx_time_step;
+  opt.wait_ccommd = 5.0;
   while ((ch = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
     char* eq;
     switch (ch) {
@@ -193,7 +215,13 @@ static int parse_args(int argc, char** argv) {
         opt.param_name[opt.n_params++] = optarg;
         break;
       }
-      case 'T': opt.period = atof(optarg); break;
+      case 'T':
+        if (!parse_seconds("--period", optarg, &opt.period)) return 0;
+        break;
+      case 'S': opt.allow_time_scaling = 1; break;
+      case 'W':
+        if (!parse_seconds("--wait-ccommd", optarg, &opt.wait_ccommd)) return 0;
+        break;
       case 'd': opt.duration = atof(optarg); break;
       case 'P': opt.priority = atoi(optarg); break;
       case 'c': opt.cpu = atoi(optarg); break;
@@ -213,6 +241,21 @@ static int parse_args(int argc, char** argv) {
   if (!(opt.period > 0.0) || opt.period > 3600.0) {
     fprintf(stderr, "period must be in (0, 3600] s\n");
     return 0;
+  }
+  /* Each step advances model time by the step size the model was generated with: a
+   * different period makes the model run faster or slower than real time. */
+  if (fabs(opt.period - ccomm_xx_time_step) > 1e-9 * ccomm_xx_time_step) {
+    const double scale = ccomm_xx_time_step / opt.period;
+    if (!opt.allow_time_scaling) {
+      fprintf(stderr,
+              "%s: --period %g s differs from the model's step size %g s: each period advances model\n"
+              "time by %g s, so the model would run at %g x real time. Generate the model with step\n"
+              "size %g s, leave --period out, or pass --allow-time-scaling to run it scaled on purpose.\n",
+              ccomm_xx_submodel_name, opt.period, ccomm_xx_time_step, ccomm_xx_time_step, scale, opt.period);
+      return 0;
+    }
+    fprintf(stderr, "%s: --allow-time-scaling: period %g s, step size %g s: model time runs at %g x real time\n",
+            ccomm_xx_submodel_name, opt.period, ccomm_xx_time_step, scale);
   }
   return 1;
 }
@@ -253,6 +296,37 @@ static int setup_realtime(void) {
   return ok || !opt.require_rt;
 }
 
+/* Opens the node's segment and checks that a ccommd serves it, waiting up to
+ * --wait-ccommd for one that is starting. A segment outlives its ccommd (a restart adopts
+ * it): without the heartbeat check a task started while ccommd is down would run on
+ * stale inputs (safe values) and exit as if all went well. */
+static int open_running_ccommd(ccomm_client** out) {
+  const char* node = opt.node ? opt.node : "(default node)";
+  struct timespec t0, now, pause = {0, 100000000};
+  int rc;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  for (;;) {
+    rc = ccomm_open(opt.node, opt.no_doorbell ? CCOMM_OPEN_NO_DOORBELL : 0, out);
+    if (rc == 0 && ccomm_daemon_alive(*out)) return 0;
+    if (rc == 0) {
+      ccomm_close(*out);
+      *out = NULL;
+    } else if (rc != CCOMM_E_NOENT && rc != CCOMM_E_RETIRED) {
+      fprintf(stderr, "%s: ccomm_open(%s): %s\n", ccomm_xx_submodel_name, node, ccomm_strerror(rc));
+      return rc;
+    }
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (ts_ns(&now) - ts_ns(&t0) >= (int64_t)llround(opt.wait_ccommd * 1e9) || stop_requested) break;
+    nanosleep(&pause, NULL);
+  }
+  fprintf(stderr,
+          "%s: no ccommd is running for node %s (%s after %g s): start it (systemctl start ccommd)\n"
+          "or wait longer with --wait-ccommd SECONDS\n",
+          ccomm_xx_submodel_name, node,
+          rc == 0 ? "its segment exists but its heartbeat has stopped" : "no segment", opt.wait_ccommd);
+  return rc ? rc : CCOMM_E_NOENT;
+}
+
 int main(int argc, char** argv) {
   static XXDouble u[XX_NUMBER_INPUTS + 1];
   static XXDouble y[XX_NUMBER_OUTPUTS + 1];
@@ -261,12 +335,8 @@ int main(int argc, char** argv) {
 
   if (!parse_args(argc, argv)) return 1;
   if (!check_parameters()) return 1;
-  rc = ccomm_open(opt.node, opt.no_doorbell ? CCOMM_OPEN_NO_DOORBELL : 0, &c);
-  if (rc != 0) {
-    fprintf(stderr, "%s: ccomm_open(%s): %s\n", ccomm_xx_submodel_name, opt.node ? opt.node : "default node",
-            ccomm_strerror(rc));
-    return 1;
-  }
+  rc = open_running_ccommd(&c);
+  if (rc != 0) return 1;
   if (!ccomm_xx_map_ports(c, &opt.map)) {
     ccomm_close(c);
     return 1;
@@ -299,6 +369,8 @@ int main(int argc, char** argv) {
   const int64_t start_ns = ts_ns(&now);
   int64_t next_ns = start_ns + period_ns;
   const int64_t end_ns = opt.duration > 0.0 ? start_ns + (int64_t)llround(opt.duration * 1e9) : INT64_MAX;
+  int64_t next_alive_check_ns = start_ns + 1000000000;
+  int ccommd_lost = 0;
   int64_t next_stats_ns = opt.stats_interval > 0.0 ? start_ns + (int64_t)llround(opt.stats_interval * 1e9) : INT64_MAX;
 
   while (!stop_requested) {
@@ -329,6 +401,16 @@ int main(int argc, char** argv) {
       stats.missed_releases += (uint64_t)missed;
       next_ns += missed * period_ns;
     }
+    if (done_ns >= next_alive_check_ns) {
+      /* Once a second, off the step's critical part: say so at once when ccommd goes. */
+      const int alive = ccomm_daemon_alive(c);
+      if (!alive && !ccommd_lost)
+        fprintf(stderr, "%s: warning: ccommd stopped; inputs are stale (safe values) until it is back\n",
+                ccomm_xx_submodel_name);
+      if (alive && ccommd_lost) fprintf(stderr, "%s: ccommd is back\n", ccomm_xx_submodel_name);
+      ccommd_lost = !alive;
+      next_alive_check_ns = done_ns + 1000000000;
+    }
     if (done_ns >= next_stats_ns) {
       print_stats(stderr);
       next_stats_ns += (int64_t)llround(opt.stats_interval * 1e9);
@@ -342,6 +424,10 @@ int main(int argc, char** argv) {
   %FUNCTIONPREFIX%TerminateSubmodel(u, y, (XXDouble)k * step);
   if (exit_code == 0) ccomm_xx_write_outputs(c, y, &stats.io);
   print_stats(stdout);
+  if (stats.io.stale_cycles > 0)
+    fprintf(stderr, "%s: warning: %llu of %llu cycles ran on stale or never-received inputs (safe values)%s\n",
+            ccomm_xx_submodel_name, (unsigned long long)stats.io.stale_cycles, (unsigned long long)stats.cycles,
+            ccommd_lost ? "; ccommd stopped during the run" : "");
   ccomm_close(c);
   return exit_code;
 }

@@ -18,7 +18,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 
 
 def _ccommd():
-    for d in (os.environ.get("CCOMM_BUILD_DIR"), os.path.join(REPO, "build-perf"), os.path.join(REPO, "build")):
+    for d in (os.environ.get("CCOMM_BUILD_DIR"), os.path.join(REPO, "build", "perf"), os.path.join(REPO, "build", "release")):
         if d and os.path.exists(os.path.join(d, "bin", "ccommd")):
             return os.path.join(d, "bin", "ccommd")
     return None

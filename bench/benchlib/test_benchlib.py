@@ -23,7 +23,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 
 
 def _bin_dir():
-    for d in (os.environ.get("CCOMM_BENCH_BIN"), os.path.join(REPO, "build-bench-floors", "bin")):
+    for d in (os.environ.get("CCOMM_BENCH_BIN"), os.path.join(REPO, "build", "bench-floors", "bin")):
         if d and os.path.exists(os.path.join(d, "shm_floor")):
             return d
     return None

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # Bounded fuzzing: every libFuzzer target in scripts/fuzz (wire decoder, config parser),
 # FUZZ_SECONDS each (default 20), built with clang + ASan/UBSan in FUZZ_BUILD_DIR
-# (default build-fuzz). A crash, leak, timeout or sanitizer report fails the test; the
+# (default build/fuzz). A crash, leak, timeout or sanitizer report fails the test; the
 # reproducer is left in FUZZ_BUILD_DIR/fuzz-work/<target>/artifacts/. Long runs: see
 # docs/reliability.md.
 source "$(dirname "$0")/lib.sh"

@@ -3,13 +3,13 @@
 # rel<pid>-<x>, daemons and helpers started here are tracked by pid and removed on exit.
 #
 # Environment:
-#   CCOMM_BUILD_DIR   build with bin/ccommd, bin/ccomm, lib/libccomm.so (default build-rel)
+#   CCOMM_BUILD_DIR   build with bin/ccommd, bin/ccomm, lib/libccomm.so (default build/release, what scripts/build makes)
 #   REL_KEEP_LOGS=1   keep the work directory (logs) after the test
 set -uo pipefail
 
 REL_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 ROOT=$(cd "$REL_DIR/../.." && pwd)
-BUILD=${CCOMM_BUILD_DIR:-$ROOT/build-rel}
+BUILD=${CCOMM_BUILD_DIR:-$ROOT/build/release}
 [[ $BUILD = /* ]] || BUILD=$ROOT/$BUILD
 BIN=$BUILD/bin
 CONFIG=$REL_DIR/reliability.xml

@@ -64,8 +64,7 @@ spawn "$WORK/w.log" control "$WORK/torture" -n control write t_state --rate 1000
 w=$!
 spawn "$WORK/c.log" planner "$WORK/torture" -n planner check t_state
 c=$!
-sleep 1
-stats planner
+wait_for 20 peer_up planner
 check "with keys on both sides the peers are up" [ "$(peer planner alive)" = true ]
 rp0=$(counter planner frames_replayed); af0=$(counter planner frames_auth_failed); sd0=$(sock_drops planner)
 in_ns control "$WORK/flood" --ifname eth0 --replay 300 --times 2 --rate 5000 >"$WORK/replay.json" 2>&1

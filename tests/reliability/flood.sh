@@ -80,8 +80,7 @@ run_transport() {  # run_transport raw|udp
   local lw=$!
   spawn "$WORK/lc-$t.log" planner "$WORK/torture" -n planner check t_local
   local lc=$!
-  sleep 0.5
-  stats planner
+  wait_for 20 peer_up planner
   check "$t: peer up before the flood" [ "$(peer planner alive)" = true ]
   local mem0; mem0=$(rss "$pid_p")
 

@@ -136,8 +136,13 @@ check "no stale segment left behind (2 segments, 2 system views: $(ls /dev/shm |
 seq_of() { cli "$1" echo "$2" --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p'; }
 status_of() { cli "$1" echo "$2" --once | grep -oE ' (fresh|stale|never)( |$)' | tr -d ' '; }
 a=$(seq_of planner t_state); la=$(seq_of control t_state); lo=$(seq_of planner t_local)
+all_moved() {  # bounded by wait_for: a starved writer on a loaded machine needs longer than 0.5 s
+  b=$(seq_of planner t_state); lb=$(seq_of control t_state); lp=$(seq_of planner t_local)
+  [ "${b:-0}" -gt "${a:-0}" ] && [ "${lb:-0}" -gt "${la:-0}" ] && [ "${lp:-0}" -gt "${lo:-0}" ] &&
+    [ "$(status_of planner t_state)" = fresh ]
+}
 sleep 0.5
-b=$(seq_of planner t_state); lb=$(seq_of control t_state); lp=$(seq_of planner t_local)
+wait_for 20 all_moved
 check "values flow end to end after the loop (t_state at planner: seq $a -> $b, $(status_of planner t_state))" \
   [ "${b:-0}" -gt "${a:-0}" -a "$(status_of planner t_state)" = fresh ]
 check "local writes succeed after the loop (t_state at control: $la -> $lb; t_local at planner: $lo -> $lp)" \

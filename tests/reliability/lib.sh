@@ -199,6 +199,9 @@ peer() {
   python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))["peers"][0]; v=p[sys.argv[2]]
 print(str(v).lower() if isinstance(v,bool) else v)' "$WORK/stats-$1.json" "$2"
 }
+# peer_up NODE: its stats (saved to stats-NODE.json) say the peer is alive. With wait_for:
+# "the peers come up" on a loaded machine without guessing how long that takes.
+peer_up() { stats "$1" && [ "$(peer "$1" alive)" = true ]; }
 # rss PID: "VmRSS VmHWM" in kB
 rss() { awk '/^VmRSS/{r=$2} /^VmHWM/{h=$2} END{print r, h}' "/proc/$1/status"; }
 # sock_drops NODE: packets dropped at ccommd's socket(s) (receive buffer full), from ss

@@ -44,8 +44,9 @@ spawn "$WORK/w.log" control "$WORK/torture" -n control write t_state --rate 500
 w=$!
 sleep 0.5
 s1=$(cli planner echo t_state --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p')
+s2_moved() { s2=$(cli planner echo t_state --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p'); [ "${s2:-0}" -gt "${s1:-0}" ]; }
 sleep 0.3
-s2=$(cli planner echo t_state --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p')
+wait_for 20 s2_moved
 kill -TERM $w; wait $w
 check "values still flow after the drop (seq $s1 -> $s2)" [ "${s2:-0}" -gt "${s1:-0}" ]
 mode=$(stat -c '%a %U:%G' /dev/shm/"$TAG".control)
@@ -87,8 +88,7 @@ else
   ip netns exec "$NS_P" setpriv --reuid="$USER_" --regid="$GROUP_" --clear-groups --inh-caps=+net_raw \
     --ambient-caps=+net_raw "$BIN/ccommd" --node planner --no-rt -c "$CONFIG" >"$WORK/user.log" 2>&1 &
   DPID[planner]=$!; PIDS+=($!)
-  sleep 1
-  stats planner
+  wait_for 20 peer_up planner
   check "as $USER_ with only ambient CAP_NET_RAW: raw transport works (peer up)" [ "$(peer planner alive)" = true ]
   # (Without CAP_SETPCAP the bounding set stays; with nothing permitted and no_new_privs
   # it grants nothing.)
@@ -112,8 +112,7 @@ else
       "$BIN/ccommd" --node $n --no-rt --transport udp -c "$CONFIG" >"$WORK/udp-$n.log" 2>&1 &
     DPID[$n]=$!; PIDS+=($!)
   done
-  sleep 1
-  stats planner
+  wait_for 20 peer_up planner
   check "as $USER_ without any capability: UDP transport works (peer up)" [ "$(peer planner alive)" = true ]
   stop_daemon control; stop_daemon planner
 fi

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Test FMU (FMI 3.0 co-simulation): a mass on a spring and damper, integrated with SUBSTEPS
 // (buildDescription.xml: 10) semi-implicit Euler sub-steps per doStep. Scalar and array inputs, a Boolean input fed
-// by a freshness mapping, a tunable parameter, scalar and array outputs.
+// by a freshness mapping, a tunable parameter, scalar and array outputs. The array input w is
+// Float32: FMPy's input table needs one shape per type, and it covers a second type.
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,7 +14,8 @@
 
 enum { VR_U = 1, VR_U_FRESH = 2, VR_W = 3, VR_K = 4, VR_X = 5, VR_STATE = 6, VR_C = 7 };
 typedef struct {
-  double u, w[2], k, c, x, v;
+  double u, k, c, x, v;
+  float w[2];
   fmi3Boolean u_fresh;
 } Plant;
 
@@ -71,7 +73,6 @@ fmi3Status fmi3GetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t 
   for (size_t n = 0; n < nvr; ++n) {
     switch (vr[n]) {
       case VR_U: if (k + 1 > nv) return fmi3Error; v[k++] = p->u; break;
-      case VR_W: if (k + 2 > nv) return fmi3Error; v[k++] = p->w[0]; v[k++] = p->w[1]; break;
       case VR_K: if (k + 1 > nv) return fmi3Error; v[k++] = p->k; break;
       case VR_C: if (k + 1 > nv) return fmi3Error; v[k++] = p->c; break;
       case VR_X: if (k + 1 > nv) return fmi3Error; v[k++] = p->x; break;
@@ -88,13 +89,27 @@ fmi3Status fmi3SetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t 
   for (size_t n = 0; n < nvr; ++n) {
     switch (vr[n]) {
       case VR_U: if (k + 1 > nv) return fmi3Error; p->u = v[k++]; break;
-      case VR_W: if (k + 2 > nv) return fmi3Error; p->w[0] = v[k++]; p->w[1] = v[k++]; break;
       case VR_K: if (k + 1 > nv) return fmi3Error; p->k = v[k++]; break;
       case VR_C: if (k + 1 > nv) return fmi3Error; p->c = v[k++]; break;
       default: return fmi3Error;
     }
   }
   return k == nv ? fmi3OK : fmi3Error;
+}
+fmi3Status fmi3GetFloat32(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 v[], size_t nv) {
+  Plant* p = i;
+  if (nvr != 1 || nv != 2 || vr[0] != VR_W) return fmi3Error;
+  v[0] = p->w[0];
+  v[1] = p->w[1];
+  return fmi3OK;
+}
+fmi3Status fmi3SetFloat32(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float32 v[],
+                          size_t nv) {
+  Plant* p = i;
+  if (nvr != 1 || nv != 2 || vr[0] != VR_W) return fmi3Error;
+  p->w[0] = v[0];
+  p->w[1] = v[1];
+  return fmi3OK;
 }
 fmi3Status fmi3GetBoolean(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean v[], size_t nv) {
   Plant* p = i;

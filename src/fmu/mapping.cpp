@@ -27,6 +27,11 @@ bool LoadMapping(const std::string& path, std::vector<MappingLine>* out, std::st
     *error = path + ": cannot read";
     return false;
   }
+  return ParseMapping(path, text, out, error);
+}
+
+bool ParseMapping(const std::string& path, const std::string& text, std::vector<MappingLine>* out,
+                  std::string* error) {
   std::set<std::string> seen;
   int line_no = 0;
   size_t pos = 0;
@@ -57,7 +62,7 @@ bool LoadMapping(const std::string& path, std::vector<MappingLine>* out, std::st
     }
     if (rhs == "-" && !m.freshness) {
       rhs.clear();
-    } else if (!IsName(rhs)) {
+    } else if (!IsName(rhs) || rhs == "-") {
       return fail("\"" + rhs + "\" is not a signal name (or fresh(<signal>), or - for not connected)");
     }
     m.signal = rhs;

@@ -21,6 +21,9 @@ struct MappingLine {
 
 // Parses `path`; false with "path:line: message" in `error`.
 bool LoadMapping(const std::string& path, std::vector<MappingLine>* out, std::string* error);
+// The same on `text` already read (`path` names it in messages).
+bool ParseMapping(const std::string& path, const std::string& text, std::vector<MappingLine>* out,
+                  std::string* error);
 
 }  // namespace ccomm::fmu
 #endif

@@ -244,13 +244,12 @@ bool ReadFile(const std::string& path, std::string* out) {
 }
 
 namespace {
-// Parses `path` into the static document (start-up only, one file at a time); false with
-// "path:line: XML error" in `error`. `buffer` keeps the text the nodes point into.
-rapidxml::xml_document<char>* ParseXml(const std::string& path, std::string* buffer, std::string* error) {
-  if (!ReadFile(path, buffer)) {
-    *error = path + ": cannot read";
-    return nullptr;
-  }
+// Parses `text` (named `path` in messages) into the static document (start-up only, one
+// file at a time); false with "path:line: XML error" in `error`. `buffer` keeps the text the
+// nodes point into.
+rapidxml::xml_document<char>* ParseXml(const std::string& path, const std::string& text, std::string* buffer,
+                                       std::string* error) {
+  *buffer = text;
   buffer->push_back('\0');
   static rapidxml::xml_document<char> doc;
   ParseFailure failure;
@@ -262,14 +261,23 @@ rapidxml::xml_document<char>* ParseXml(const std::string& path, std::string* buf
   doc.clear();
   // Lines are counted in the parsed buffer: RapidXML writes terminators but keeps newlines
   // in place, so offsets match the file.
-  doc.parse<rapidxml::parse_default>(&(*buffer)[0]);
+  doc.parse<rapidxml::parse_validate_closing_tags>(&(*buffer)[0]);
   return &doc;
+}
+rapidxml::xml_document<char>* ParseXmlFile(const std::string& path, std::string* buffer, std::string* error) {
+  std::string text;
+  if (!ReadFile(path, &text)) {
+    *error = path + ": cannot read";
+    return nullptr;
+  }
+  return ParseXml(path, text, buffer, error);
 }
 }  // namespace
 
-bool LoadModelDescription(const std::string& path, ModelDescription* out, std::string* error) {
+bool ParseModelDescription(const std::string& path, const std::string& text, ModelDescription* out,
+                           std::string* error) {
   std::string buffer;
-  rapidxml::xml_document<char>* doc = ParseXml(path, &buffer, error);
+  rapidxml::xml_document<char>* doc = ParseXml(path, text, &buffer, error);
   if (doc == nullptr) return false;
   Parser parser(path, buffer);
   if (!parser.Run(doc->first_node(), out)) {
@@ -279,10 +287,19 @@ bool LoadModelDescription(const std::string& path, ModelDescription* out, std::s
   return true;
 }
 
+bool LoadModelDescription(const std::string& path, ModelDescription* out, std::string* error) {
+  std::string text;
+  if (!ReadFile(path, &text)) {
+    *error = path + ": cannot read";
+    return false;
+  }
+  return ParseModelDescription(path, text, out, error);
+}
+
 bool LoadBuildDescription(const std::string& path, const std::string& model_identifier, BuildDescription* out,
                           std::string* error) {
   std::string buffer;
-  rapidxml::xml_document<char>* doc = ParseXml(path, &buffer, error);
+  rapidxml::xml_document<char>* doc = ParseXmlFile(path, &buffer, error);
   if (doc == nullptr) return false;
   Node* root = doc->first_node();
   auto fail = [&](const char* where, const std::string& m) {

@@ -38,6 +38,9 @@ struct ModelDescription {
 
 // Parses `path`; false with a file:line message in `error`.
 bool LoadModelDescription(const std::string& path, ModelDescription* out, std::string* error);
+// The same on `text` already read (`path` names it in messages).
+bool ParseModelDescription(const std::string& path, const std::string& text, ModelDescription* out,
+                           std::string* error);
 
 // FMI 3.0 sources/buildDescription.xml: the C sources of `model_identifier` and how to
 // compile them (paths relative to sources/).

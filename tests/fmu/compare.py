@@ -69,7 +69,7 @@ def main(argv):
         differ = np.nonzero(np.any(mine != theirs, axis=1))[0]
         if len(differ):
             k = differ[0]
-            print(f"{name}: {len(differ)} of {n} samples differ; first at cycle {k}: ccomm-fmu {mine[k]} FMPy {theirs[k]}")
+            print(f"{name}: {len(differ)} of {n} samples differ; first at cycle {k}: ccomm-fmu {mine[k].tolist()} FMPy {theirs[k].tolist()}")
             failed += 1
         else:
             print(f"{name}: {n} samples equal FMPy's, bit for bit (range {mine.min():.6g} .. {mine.max():.6g})")

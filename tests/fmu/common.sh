@@ -2,11 +2,14 @@
 # Shared by tests/fmu/run and tests/fmu/bench (sourced after tests/reliability/lib.sh):
 # FMPy pinned in a venv, and the test FMUs packed as source FMUs and built by ccomm-fmu build.
 # ---- FMPy, pinned (with the versions of what it pulls in) -------------------------------
-FMPY_PINS=(fmpy==0.3.32 numpy==2.4.6 lxml==6.1.3 lark==1.3.1 attrs==26.1.0 Jinja2==3.1.6 MarkupSafe==3.0.4
-           msgpack==1.2.4)
+FMPY_PINS=(fmpy==0.3.32 attrs==26.1.0 cmake==4.4.5 fastjsonschema==2.22.3 Jinja2==3.1.6 jsonschema==4.26.0
+           jsonschema-specifications==2025.9.1 jupyter_core==5.9.1 lark==1.3.1 lxml==6.1.3 MarkupSafe==3.0.4
+           msgpack==1.2.4 nbformat==5.11.1 numpy==2.4.6 platformdirs==4.14.8 referencing==0.37.0 rpds-py==2026.9.1
+           traitlets==5.16.1 typing_extensions==4.16.0)
 venv=${FMPY_VENV:-$ROOT/.cache/fmpy-venv}
 if ! "$venv/bin/python" -c 'import fmpy, sys; sys.exit(fmpy.__version__ != "0.3.32")' 2>/dev/null; then
-  python3 -m venv "$venv" && "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "${FMPY_PINS[@]}" ||
+  python3 -m venv "$venv" &&
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps "${FMPY_PINS[@]}" ||
     skip_all "cannot install FMPy from PyPI into $venv"
 fi
 PY=$venv/bin/python

@@ -98,9 +98,8 @@ USERADD_PARAM:${PN} = "--system --user-group --home-dir / --no-create-home --she
 
 FILES:lib${BPN} += "${libdir}/libccomm${SOLIBS}"
 FILES:${PN}-cli += "${bindir}/ccomm ${bindir}/ccomm-latency"
-# ccomm-fmu: FMUs as real-time tasks; a .fmu is a zip archive (unzip to run, zip to build)
+# ccomm-fmu: FMUs as real-time tasks
 FILES:${PN}-fmu += "${bindir}/ccomm-fmu"
-RRECOMMENDS:${PN}-fmu = "unzip zip"
 # 20-sim / Simulink templates and generators (Python scripts)
 FILES:${PN}-integrations += "${datadir}/ccomm/integrations"
 FILES:${PN} += "${systemd_system_unitdir}/ccommd.service ${nonarch_libdir}/sysusers.d/ccomm.conf"
@@ -110,5 +109,7 @@ CONFFILES:${PN} = "${sysconfdir}/ccomm/signals.xml"
 RDEPENDS:${PN}-integrations = "python3-core"
 # the CLI is how a person (and the oeqa test) reads and writes signals on the board
 RRECOMMENDS:${PN} = "${PN}-cli"
+# a .fmu is a zip archive (unzip to run one, zip to build one)
+RRECOMMENDS:${PN}-fmu = "unzip zip"
 
 CVE_PRODUCT = "ccomm"

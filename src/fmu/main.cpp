@@ -105,6 +105,10 @@ bool ValidateSchema(const std::string& schema_dir, int major, const std::string&
     *error = xsd + ": cannot read the schema";
     return false;
   }
+  if (xsd.find('\'') != std::string::npos || xml.find('\'') != std::string::npos) {
+    *error = "a path with a quote cannot be handed to xmllint";
+    return false;
+  }
   std::string cmd = "xmllint --noout --schema '" + xsd + "' '" + xml + "' 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) {

@@ -86,7 +86,7 @@ do_install_ptest() {
     install -m 0644 ${S}/examples/*.xml ${D}${PTEST_PATH}/source/examples/
 }
 
-PACKAGE_BEFORE_PN = "lib${BPN} ${PN}-cli ${PN}-integrations"
+PACKAGE_BEFORE_PN = "lib${BPN} ${PN}-cli ${PN}-fmu ${PN}-integrations"
 
 SYSTEMD_SERVICE:${PN} = "ccommd.service"
 SYSTEMD_AUTO_ENABLE:${PN} = "enable"
@@ -98,6 +98,8 @@ USERADD_PARAM:${PN} = "--system --user-group --home-dir / --no-create-home --she
 
 FILES:lib${BPN} += "${libdir}/libccomm${SOLIBS}"
 FILES:${PN}-cli += "${bindir}/ccomm ${bindir}/ccomm-latency"
+# ccomm-fmu: FMUs as real-time tasks
+FILES:${PN}-fmu += "${bindir}/ccomm-fmu"
 # 20-sim / Simulink templates and generators (Python scripts)
 FILES:${PN}-integrations += "${datadir}/ccomm/integrations"
 FILES:${PN} += "${systemd_system_unitdir}/ccommd.service ${nonarch_libdir}/sysusers.d/ccomm.conf"
@@ -107,5 +109,7 @@ CONFFILES:${PN} = "${sysconfdir}/ccomm/signals.xml"
 RDEPENDS:${PN}-integrations = "python3-core"
 # the CLI is how a person (and the oeqa test) reads and writes signals on the board
 RRECOMMENDS:${PN} = "${PN}-cli"
+# a .fmu is a zip archive (unzip to run one, zip to build one)
+RRECOMMENDS:${PN}-fmu = "unzip zip"
 
 CVE_PRODUCT = "ccomm"

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 SUMMARY = "Console image for a board running ccommd"
-DESCRIPTION = "Boots to a serial/SSH console with ccommd enabled, the ccomm CLI, \
+DESCRIPTION = "Boots to a serial/SSH console with ccommd enabled, the ccomm CLI, ccomm-fmu, \
                the unit tests (ccomm-ptest) and dropbear."
 BUGTRACKER = "https://github.com/ccomm/ccomm/issues"
 SECTION = "images"
@@ -11,6 +11,7 @@ inherit core-image
 IMAGE_INSTALL = "packagegroup-core-boot \
                  ccomm \
                  ccomm-cli \
+                 ccomm-fmu \
                  ${@bb.utils.contains('DISTRO_FEATURES', 'ptest', 'ccomm-ptest ptest-runner', '', d)} \
                  dropbear \
                  ${CORE_IMAGE_EXTRA_INSTALL} \

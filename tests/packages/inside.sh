@@ -29,8 +29,10 @@ check "system user and group ccomm (sysusers at configure)" bash -c 'getent pass
 check "ccommd.service enabled (not started)" test -L /etc/systemd/system/multi-user.target.wants/ccommd.service
 check "/etc/ccomm/signals.xml is a conffile" bash -c "dpkg-query -W -f='\${Conffiles}' ccommd | grep -q /etc/ccomm/signals.xml"
 check "the installed signals.xml passes ccommd --check" ccommd --check /etc/ccomm/signals.xml
-check "man pages ccommd(8), ccomm(1), ccomm-latency(1)" \
-  test -s /usr/share/man/man8/ccommd.8.gz -a -s /usr/share/man/man1/ccomm.1.gz -a -s /usr/share/man/man1/ccomm-latency.1.gz
+check "man pages ccommd(8), ccomm(1), ccomm-latency(1), ccomm-fmu(1)" \
+  test -s /usr/share/man/man8/ccommd.8.gz -a -s /usr/share/man/man1/ccomm.1.gz -a -s /usr/share/man/man1/ccomm-latency.1.gz \
+    -a -s /usr/share/man/man1/ccomm-fmu.1.gz
+check "ccomm-fmu installed (--help)" bash -c "ccomm-fmu --help | grep -q 'ccomm-fmu run FMU'"
 check "ccommd --version says $CCOMM_VERSION" bash -c "ccommd --version | grep -q '$CCOMM_VERSION'"
 
 # ---- ccommd, started directly (no systemd in a chroot) ------------------------------------

@@ -1,0 +1,376 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "runner.h"
+
+#include <ftw.h>
+#include <sched.h>
+#include <spawn.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cinttypes>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+
+extern char** environ;
+
+namespace ccomm::fmu {
+namespace {
+
+int CcommTypeOf(FmiType t) {
+  switch (t) {
+    case FmiType::kFloat64: return CCOMM_DOUBLE;
+    case FmiType::kFloat32: return CCOMM_FLOAT;
+    case FmiType::kInt32: return CCOMM_INT32;
+    case FmiType::kUInt32: return CCOMM_UINT32;
+    case FmiType::kInt64: return CCOMM_INT64;
+    case FmiType::kBool: return CCOMM_BOOL;
+    default: return 0;
+  }
+}
+const char* CcommTypeName(int t) {
+  static const char* const kNames[] = {"?", "bool", "int32", "uint32", "int64", "float", "double"};
+  return t >= 1 && t <= 6 ? kNames[t] : "?";
+}
+int64_t Now() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
+int RemoveEntry(const char* path, const struct stat*, int, FTW*) { return remove(path); }
+
+}  // namespace
+
+UnpackedFmu::~UnpackedFmu() {
+  if (temporary_) nftw(dir_.c_str(), RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+bool UnpackedFmu::Open(const std::string& path, std::string* error) {
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) {
+    *error = path + ": " + std::strerror(errno);
+    return false;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    char* real = realpath(path.c_str(), nullptr);
+    dir_ = real != nullptr ? real : path;
+    std::free(real);
+    return true;
+  }
+  const char* tmp = std::getenv("TMPDIR");
+  std::string templ = std::string(tmp != nullptr && *tmp ? tmp : "/tmp") + "/ccomm-fmu-XXXXXX";
+  if (mkdtemp(&templ[0]) == nullptr) {
+    *error = "cannot create a directory to unpack " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  dir_ = templ;
+  temporary_ = true;
+  // An FMU is a zip archive: unzip (busybox has one) keeps this program free of an archive library.
+  const char* argv[] = {"unzip", "-q", "-o", path.c_str(), "-d", dir_.c_str(), nullptr};
+  pid_t pid;
+  int status = 0;
+  if (posix_spawnp(&pid, "unzip", nullptr, nullptr, const_cast<char**>(argv), environ) != 0 ||
+      waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    *error = "cannot unpack " + path + " (unzip failed or is missing): is it an FMU?";
+    return false;
+  }
+  return true;
+}
+
+Runner::~Runner() {
+  if (client_ != nullptr) ccomm_close(client_);
+}
+
+bool Runner::Bind(const std::vector<MappingLine>& mapping, const std::string& map_path, std::string* error) {
+  int rc = ccomm_open(opt_.node, CCOMM_OPEN_BATCH, &client_);
+  if (rc != 0) {
+    *error = std::string("cannot attach to node ") + (opt_.node ? opt_.node : "(default)") + ": " +
+             ccomm_strerror(rc) + " (is ccommd running?)";
+    return false;
+  }
+  std::map<std::string, const MappingLine*> by_variable;
+  for (const MappingLine& m : mapping) {
+    const Variable* v = md_.Find(m.variable);
+    auto at = [&](const std::string& msg) {
+      *error = map_path + ":" + std::to_string(m.line) + ": " + msg;
+      return false;
+    };
+    if (v == nullptr) return at("the FMU has no variable \"" + m.variable + "\"");
+    if (m.freshness && (v->causality != Causality::kInput || v->type != FmiType::kBool || v->count != 1))
+      return at("fresh(" + m.signal + ") needs a scalar Boolean input; \"" + m.variable + "\" is not one");
+    if (!m.signal.empty() && v->causality == Causality::kParameter && v->variability != "tunable")
+      return at("parameter \"" + m.variable + "\" is " + v->variability +
+                ", not tunable: it cannot follow a signal while running");
+    if (!m.signal.empty() && v->causality == Causality::kOther)
+      return at("\"" + m.variable + "\" is neither an input, an output nor a parameter");
+    by_variable[m.variable] = &m;
+  }
+  for (const Variable& v : md_.variables) {
+    if (v.causality == Causality::kOther) continue;
+    auto it = by_variable.find(v.name);
+    const MappingLine* m = it != by_variable.end() ? it->second : nullptr;
+    if (m != nullptr && m->signal.empty()) continue;  // "= -": not connected
+    const bool tunable = v.causality == Causality::kParameter && v.variability == "tunable";
+    if (v.causality == Causality::kParameter && !tunable) continue;
+    const std::string where = "modelDescription.xml:" + std::to_string(v.line) + ": ";
+    const char* role = v.causality == Causality::kInput ? "input" : v.causality == Causality::kOutput ? "output"
+                                                                                                       : "parameter";
+    Binding b{&v, -1, m != nullptr ? m->signal : v.name, Kind::kInput, 0, {}, {}, 0};
+    b.kind = m != nullptr && m->freshness ? Kind::kFreshness
+             : v.causality == Causality::kInput ? Kind::kInput
+             : v.causality == Causality::kOutput ? Kind::kOutput : Kind::kParameter;
+    b.signal = ccomm_find(client_, b.signal_name.c_str());
+    if (b.signal < 0) {
+      if (tunable && m == nullptr) continue;  // parameters follow a signal only where one exists
+      *error = where + std::string("FMU ") + role + " \"" + v.name + "\": no signal \"" + b.signal_name +
+               "\" on node " + ccomm_node_name(client_) + " (map it to another signal or to - in a --map file)";
+      return false;
+    }
+    ccomm_signal_desc d;
+    ccomm_describe(client_, b.signal, &d);
+    if (d.is_event) {
+      *error = where + "signal \"" + b.signal_name + "\" is an event; ccomm-fmu maps state signals only";
+      return false;
+    }
+    if (b.kind == Kind::kFreshness) {
+      b.bytes = d.value_bytes;
+    } else {
+      if (v.type == FmiType::kOther) {
+        *error = where + std::string("FMU ") + role + " \"" + v.name + "\" has type " + v.type_name +
+                 ", which ccomm has no signal type for (supported: Float64/Real, Float32, Int32/Integer, UInt32, "
+                 "Int64, Boolean); map it to - to leave it unconnected";
+        return false;
+      }
+      if (d.type != CcommTypeOf(v.type) || d.count != v.count) {
+        *error = where + std::string("type mismatch: FMU ") + role + " \"" + v.name + "\" is " + v.type_name +
+                 (v.count > 1 ? "[" + std::to_string(v.count) + "]" : "") + ", signal \"" + b.signal_name + "\" is " +
+                 CcommTypeName(d.type) + (d.count > 1 ? "[" + std::to_string(d.count) + "]" : "") +
+                 " (needs " + CcommTypeName(CcommTypeOf(v.type)) +
+                 (v.count > 1 ? "[" + std::to_string(v.count) + "]" : "") + ")";
+        return false;
+      }
+      b.bytes = d.value_bytes;
+    }
+    if (b.kind == Kind::kOutput && !d.produced_here) {
+      *error = where + "FMU output \"" + v.name + "\" -> signal \"" + b.signal_name + "\": node " +
+               ccomm_node_name(client_) + " is not its producer (" + d.producer + " is)";
+      return false;
+    }
+    if (b.kind != Kind::kOutput && !d.produced_here && !d.consumed_here) {
+      *error = where + "signal \"" + b.signal_name + "\" does not reach node " + ccomm_node_name(client_) +
+               " (add it to the signal's consumers)";
+      return false;
+    }
+    b.value.assign(b.bytes, 0);
+    b.incoming.assign(b.bytes, 0);
+    bindings_.push_back(std::move(b));
+  }
+  for (const Binding& b : bindings_) record_columns_ += b.kind == Kind::kFreshness ? 1 : b.var->count;
+  return true;
+}
+
+void Runner::PrintBindings(FILE* out) const {
+  for (const Binding& b : bindings_) {
+    const char* arrow = b.kind == Kind::kOutput ? "->" : "<-";
+    std::fprintf(out, "ccomm-fmu: %-9s %s %s %s%s%s\n",
+                 b.kind == Kind::kInput ? "input" : b.kind == Kind::kFreshness ? "freshness"
+                 : b.kind == Kind::kOutput ? "output" : "parameter",
+                 b.var->name.c_str(), arrow, b.kind == Kind::kFreshness ? "fresh(" : "", b.signal_name.c_str(),
+                 b.kind == Kind::kFreshness ? ")" : "");
+  }
+}
+
+void Runner::SetUpRealtime() {
+  if (!opt_.realtime) return;
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
+                 std::strerror(errno));
+  if (opt_.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(opt_.cpu, &set);
+    if (sched_setaffinity(0, sizeof set, &set) != 0)
+      std::fprintf(stderr, "ccomm-fmu: warning: cannot pin to CPU %d (%s)\n", opt_.cpu, std::strerror(errno));
+  }
+  sched_param sp{};
+  sp.sched_priority = opt_.priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+    std::fprintf(stderr, "ccomm-fmu: warning: SCHED_FIFO %d not permitted (%s): running SCHED_OTHER, "
+                 "without real-time guarantees (give CAP_SYS_NICE or an rtprio limit)\n",
+                 opt_.priority, std::strerror(errno));
+  // Touch the stack the FMU may use so that its pages are resident before the first cycle.
+  volatile char stack[256 * 1024];
+  for (size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
+}
+
+int Runner::Fail(int status, const char* what) {
+  std::fprintf(stderr, "ccomm-fmu: the FMU %s %s at t = %.9g s (cycle %" PRIu64 "); the task stops, its outputs "
+               "turn stale for their consumers\n", md_.model_name.c_str(), what,
+               static_cast<double>(cycle_) * opt_.period_ns * 1e-9, static_cast<uint64_t>(cycle_));
+  binary_.Finish(status);
+  Report(stderr);
+  WriteRecord();
+  return 3;
+}
+
+double Runner::ElementAsDouble(const Binding& b, uint32_t i) {
+  const uint8_t* p = b.value.data();
+  switch (b.var->type) {
+    case FmiType::kFloat64: { double v; std::memcpy(&v, p + 8 * i, 8); return v; }
+    case FmiType::kFloat32: { float v; std::memcpy(&v, p + 4 * i, 4); return v; }
+    case FmiType::kInt32: { int32_t v; std::memcpy(&v, p + 4 * i, 4); return v; }
+    case FmiType::kUInt32: { uint32_t v; std::memcpy(&v, p + 4 * i, 4); return v; }
+    case FmiType::kInt64: { int64_t v; std::memcpy(&v, p + 8 * i, 8); return static_cast<double>(v); }
+    default: return p[i];
+  }
+}
+
+int Runner::Run(volatile sig_atomic_t* stop) {
+  std::string error;
+  if (!binary_.Instantiate(md_.model_name, opt_.fmu_logging, &error) || !binary_.Initialize(&error)) {
+    std::fprintf(stderr, "ccomm-fmu: %s: %s\n", md_.model_name.c_str(), error.c_str());
+    binary_.Finish(kFmi3Error);
+    return 1;
+  }
+  // The values the FMU holds before the first cycle (start values), so that the record
+  // shows what each cycle really gave the FMU also before a signal's first value.
+  for (Binding& b : bindings_)
+    if (b.kind == Kind::kInput || b.kind == Kind::kParameter)
+      binary_.Get(b.var->type, b.var->value_reference, b.var->count, b.value.data());
+  const uint32_t columns = 3 + record_columns_ + (opt_.measure ? 2 : 0);
+  if (!opt_.record_path.empty()) record_.assign(opt_.cycles * columns, 0.0);  // preallocated before the loop
+  SetUpRealtime();
+  std::fprintf(stderr, "ccomm-fmu: running %s (FMI %d.0) every %g ms on node %s\n", md_.model_name.c_str(),
+               binary_.fmi_major(), opt_.period_ns * 1e-6, ccomm_node_name(client_));
+  const int64_t period = opt_.period_ns;
+  // Model time t_k = k * h exactly (no drift over long runs); each doStep spans t_k..t_k+1.
+  const double h = static_cast<double>(period) / 1e9;
+  int64_t release = Now();
+  while (!*stop && (opt_.cycles == 0 || cycle_ < opt_.cycles)) {
+    const int64_t now = Now();  // the cycle's one clock reading
+    int64_t late = now - release;
+    if (late >= period) {  // missed releases: counted, skipped; the model advances one period per cycle
+      const int64_t missed = late / period;
+      overruns_ += static_cast<uint64_t>(missed);
+      release += missed * period;
+      late -= missed * period;
+    }
+    if (late > max_lateness_) max_lateness_ = late;
+    sum_lateness_ += late;
+    ccomm_set_time(client_, now);
+    const double t = static_cast<double>(cycle_) * h;
+    for (Binding& b : bindings_) {
+      if (b.kind == Kind::kOutput) continue;
+      ccomm_info info;
+      int rc = ccomm_read(client_, b.signal, b.incoming.data(), b.bytes, &info);
+      if (rc == CCOMM_E_RETIRED) {
+        std::fputs("ccomm-fmu: ccommd replaced the segment (new configuration): stopping; restart the task\n", stderr);
+        binary_.Finish(kFmi3OK);
+        return 75;
+      }
+      if (rc < 0) { ++read_errors_; continue; }
+      if (rc == CCOMM_STALE) ++stale_reads_;
+      int set = 0;
+      if (b.kind == Kind::kFreshness) {
+        uint8_t fresh = rc == CCOMM_FRESH;
+        b.value[0] = fresh;
+        set = binary_.Set(FmiType::kBool, b.var->value_reference, 1, &fresh);
+      } else if (rc == CCOMM_NEVER && !(info.flags & CCOMM_INFO_SAFE_VALUE)) {
+        continue;  // nothing yet and no safe value: the FMU keeps its start value
+      } else {
+        if (b.kind == Kind::kParameter) {
+          if (info.seq == b.last_seq && !(info.flags & CCOMM_INFO_SAFE_VALUE)) continue;  // set new values only
+          b.last_seq = info.seq;
+        }
+        std::memcpy(b.value.data(), b.incoming.data(), b.bytes);
+        set = binary_.Set(b.var->type, b.var->value_reference, b.var->count, b.value.data());
+      }
+      if (set != 0) return Fail(set, (std::string("refused input ") + b.var->name + " (" + StatusName(set) + ")").c_str());
+    }
+    bool terminate = false;
+    const int64_t step_start = opt_.measure ? Now() : 0;
+    const int s = binary_.DoStep(t, static_cast<double>(cycle_ + 1) * h - t, &terminate);
+    const int64_t step_end = opt_.measure ? Now() : 0;
+    if (s != 0) return Fail(s, (std::string("returned ") + StatusName(s) + " from doStep").c_str());
+    if (terminate) return Fail(kFmi3OK, "asked to terminate the simulation in doStep");
+    for (Binding& b : bindings_) {
+      if (b.kind != Kind::kOutput) continue;
+      int g = binary_.Get(b.var->type, b.var->value_reference, b.var->count, b.value.data());
+      if (g != 0) return Fail(g, (std::string("refused to give output ") + b.var->name).c_str());
+      if (ccomm_write(client_, b.signal, b.value.data(), b.bytes) != 0) ++write_errors_;
+    }
+    if (ccomm_flush(client_) != 0) ++write_errors_;  // the outputs leave in one frame
+    if (opt_.measure) {
+      const int64_t end = Now();
+      max_step_ = std::max(max_step_, step_end - step_start);
+      sum_step_ += step_end - step_start;
+      max_cycle_ = std::max(max_cycle_, end - now);
+      sum_cycle_ += end - now;
+    }
+    if (!record_.empty()) {
+      double* row = &record_[cycle_ * columns];
+      *row++ = static_cast<double>(cycle_);
+      *row++ = t;
+      *row++ = static_cast<double>(late);
+      for (const Binding& b : bindings_) {
+        const uint32_t n = b.kind == Kind::kFreshness ? 1 : b.var->count;
+        for (uint32_t i = 0; i < n; ++i) *row++ = b.kind == Kind::kFreshness ? b.value[0] : ElementAsDouble(b, i);
+      }
+      if (opt_.measure) {
+        *row++ = static_cast<double>(step_end - step_start);
+        *row++ = static_cast<double>(Now() - now);
+      }
+    }
+    cycle_ = cycle_ + 1;
+    release += period;
+    timespec ts{static_cast<time_t>(release / 1000000000LL), static_cast<long>(release % 1000000000LL)};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !*stop) {
+    }
+  }
+  binary_.Finish(kFmi3OK);
+  Report(stderr);
+  WriteRecord();
+  return 0;
+}
+
+void Runner::Report(FILE* out) const {
+  const uint64_t n = cycle_ > 0 ? cycle_ : 1;
+  std::fprintf(out, "ccomm-fmu: %" PRIu64 " cycles, %" PRIu64 " overruns (missed releases; the model lags real "
+               "time by as many periods), lateness mean %.1f us max %.1f us, %" PRIu64 " stale reads, %" PRIu64
+               " read errors, %" PRIu64 " write errors\n", static_cast<uint64_t>(cycle_), overruns_,
+               sum_lateness_ / 1e3 / n, max_lateness_ / 1e3, stale_reads_, read_errors_, write_errors_);
+  if (opt_.measure)
+    std::fprintf(out, "ccomm-fmu: doStep mean %.2f us max %.2f us; whole cycle mean %.2f us max %.2f us; "
+                 "ccomm-fmu's own cost per cycle %.2f us\n", sum_step_ / 1e3 / n, max_step_ / 1e3,
+                 sum_cycle_ / 1e3 / n, max_cycle_ / 1e3, (sum_cycle_ - sum_step_) / 1e3 / n);
+}
+
+void Runner::WriteRecord() const {
+  if (opt_.record_path.empty()) return;
+  FILE* f = std::fopen(opt_.record_path.c_str(), "w");
+  if (f == nullptr) {
+    std::fprintf(stderr, "ccomm-fmu: cannot write %s: %s\n", opt_.record_path.c_str(), std::strerror(errno));
+    return;
+  }
+  std::fputs("cycle,time,lateness_ns", f);
+  for (const Binding& b : bindings_) {
+    const uint32_t n = b.kind == Kind::kFreshness ? 1 : b.var->count;
+    for (uint32_t i = 0; i < n; ++i)
+      n > 1 ? std::fprintf(f, ",%s[%u]", b.var->name.c_str(), i) : std::fprintf(f, ",%s", b.var->name.c_str());
+  }
+  if (opt_.measure) std::fputs(",dostep_ns,cycle_ns", f);
+  std::fputc('\n', f);
+  const uint32_t columns = 3 + record_columns_ + (opt_.measure ? 2 : 0);
+  for (uint64_t r = 0; r < cycle_; ++r) {
+    for (uint32_t c = 0; c < columns; ++c) std::fprintf(f, c ? ",%.17g" : "%.17g", record_[r * columns + c]);
+    std::fputc('\n', f);
+  }
+  std::fclose(f);
+}
+
+}  // namespace ccomm::fmu

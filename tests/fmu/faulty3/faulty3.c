@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+// Test FMU (FMI 3.0): counts its steps on output "beat" until input "fault" asks it to fail:
+// 1 doStep returns Error, 2 Discard, 3 asks to terminate, 4 dereferences NULL (SIGSEGV).
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi3Functions.h"
+
+enum { VR_FAULT = 1, VR_BEAT = 2 };
+typedef struct {
+  int fault;
+  double beat;
+  fmi3LogMessageCallback log;
+  fmi3InstanceEnvironment env;
+} Faulty;
+
+const char* fmi3GetVersion(void) { return fmi3Version; }
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,
+                                         fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_return,
+                                         const fmi3ValueReference required[], size_t n_required,
+                                         fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
+                                         fmi3IntermediateUpdateCallback update) {
+  (void)name; (void)token; (void)resources; (void)visible; (void)logging; (void)event_mode; (void)early_return;
+  (void)required; (void)n_required; (void)update;
+  Faulty* f = calloc(1, sizeof *f);
+  f->log = log;
+  f->env = env;
+  return f;
+}
+void fmi3FreeInstance(fmi3Instance i) { free(i); }
+fmi3Status fmi3EnterInitializationMode(fmi3Instance i, fmi3Boolean a, fmi3Float64 b, fmi3Float64 c, fmi3Boolean d,
+                                       fmi3Float64 e) {
+  (void)i; (void)a; (void)b; (void)c; (void)d; (void)e;
+  return fmi3OK;
+}
+fmi3Status fmi3ExitInitializationMode(fmi3Instance i) { (void)i; return fmi3OK; }
+fmi3Status fmi3Terminate(fmi3Instance i) { (void)i; return fmi3OK; }
+
+fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean no_set_prior, fmi3Boolean* event,
+                      fmi3Boolean* terminate, fmi3Boolean* early, fmi3Float64* last) {
+  Faulty* f = i;
+  (void)no_set_prior;
+  *event = *terminate = *early = fmi3False;
+  *last = t + h;
+  switch (f->fault) {
+    case 1:
+      f->log(f->env, fmi3Error, "logStatusError", "faulty3: the model failed on purpose");
+      return fmi3Error;
+    case 2: return fmi3Discard;
+    case 3: *terminate = fmi3True; break;
+    case 4: { volatile int* volatile nowhere = NULL; *nowhere = 1; break; }
+    default: break;
+  }
+  f->beat += 1;
+  return fmi3OK;
+}
+fmi3Status fmi3GetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 v[], size_t nv) {
+  if (nvr != 1 || nv != 1 || vr[0] != VR_BEAT) return fmi3Error;
+  v[0] = ((Faulty*)i)->beat;
+  return fmi3OK;
+}
+fmi3Status fmi3GetInt32(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 v[], size_t nv) {
+  if (nvr != 1 || nv != 1 || vr[0] != VR_FAULT) return fmi3Error;
+  v[0] = ((Faulty*)i)->fault;
+  return fmi3OK;
+}
+fmi3Status fmi3SetInt32(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 v[], size_t nv) {
+  if (nvr != 1 || nv != 1 || vr[0] != VR_FAULT) return fmi3Error;
+  ((Faulty*)i)->fault = v[0];
+  return fmi3OK;
+}

@@ -86,7 +86,10 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
     if (cfg.network.fanout == Fanout::kMulticast) continue;  // one frame to our group, below
     Dest d;
     if (!PeerAddressFor(cfg.network, cfg.nodes[p], kind, &d.addr)) continue;  // unreachable: no summary
-    d.dest = static_cast<uint16_t>(p);
+    // A raw node without mac= is reached by Ethernet broadcast: every station gets the
+    // frame, so it says so (protocol.md, "Node summary"), also when that node is the only one.
+    const bool broadcast = kind == TransportKind::kRaw && !cfg.nodes[p].has_mac;
+    d.dest = broadcast ? wire::kDestAll : static_cast<uint16_t>(p);
     bool shared = false;
     for (Dest& o : dests_) {
       if (SameAddress(o.addr, d.addr, kind)) {  // broadcast MAC or a shared group: send once to all
@@ -97,10 +100,9 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
     if (!shared) dests_.push_back(d);
   }
   if (cfg.network.fanout == Fanout::kMulticast && cfg.network.summary_ms != 0 && transport->ops != nullptr) {
-    // Multicast fan-out: once to this node's group, like its data; the nodes that exchange
-    // signals with it (monitor nodes included) joined that group.
+    // Multicast fan-out: once to the summary group, which every node joined (daemon.cpp).
     Dest d;
-    d.addr = GroupAddressFor(cfg.network, self, kind);
+    d.addr = GroupAddressFor(cfg.network, kSummaryGroup, kind);
     d.dest = wire::kDestAll;
     dests_.push_back(d);
   }

@@ -93,8 +93,10 @@ static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* 
 }
 
 bool LooksLikeNumber(const char* word) {
-  double d;
-  return config_detail::ParseValueElement(ValueType::kDouble, word, &d) != config_detail::NumResult::kSyntax;
+  using config_detail::NumResult;
+  uint8_t v[8];
+  return config_detail::ParseValueElement(ValueType::kDouble, word, v) != NumResult::kSyntax ||
+         config_detail::ParseValueElement(ValueType::kInt64, word, v) != NumResult::kSyntax;  // -0x10
 }
 
 bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error) {

@@ -237,6 +237,8 @@ SystemView::Verdict SystemView::Receive(const uint8_t* frame, const wire::FrameH
                                         const PeerAddress& from) {
   store::ViewHeader* vh = view_.mutable_header();
   Verdict v = Verdict::kApplied;
+  if (h.sender == self_ && senders_[self_].ipv4 && from.ipv4 == senders_[self_].ipv4 && h.dest == wire::kDestAll)
+    return Verdict::kOwn;
   if (h.sender >= senders_.size() || h.sender == self_) v = Verdict::kUnknownSender;
   else if (senders_[h.sender].ipv4 && from.ipv4 != senders_[h.sender].ipv4) v = Verdict::kWrongSource;
   else if (h.dest != self_ && h.dest != wire::kDestAll) v = Verdict::kNotForUs;
@@ -308,6 +310,7 @@ void Daemon::HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint6
   switch (view_.Receive(buf, h, now, from)) {
     case SystemView::Verdict::kApplied: Count(store::kFramesRx, std::memory_order_release); break;
     case SystemView::Verdict::kOld: Count(store::kFramesRx); break;  // a duplicate, like data ones
+    case SystemView::Verdict::kOwn: break;
     case SystemView::Verdict::kUnknownSender: Count(store::kFramesUnknownSender); break;
     case SystemView::Verdict::kWrongSource: Count(store::kFramesWrongSource); break;
     case SystemView::Verdict::kNotForUs: Count(store::kFramesNotForUs); break;

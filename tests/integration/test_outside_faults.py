@@ -80,8 +80,7 @@ def in_small_shm(cmd, size="256m", limit_as=None):
               % (size, prlimit, " ".join(cmd)))
     p = subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c", script], capture_output=True,
                        text=True, timeout=120)
-    out = p.stdout + p.stderr
-    return p.returncode, out, out.rsplit("LEFT:", 1)[1].strip()
+    return p.returncode, p.stdout + p.stderr, p.stdout.rsplit("LEFT:", 1)[1].strip()
 
 
 def test_segment_too_big_for_the_machine_is_refused_with_exit_3(tmp_path):
@@ -91,11 +90,11 @@ def test_segment_too_big_for_the_machine_is_refused_with_exit_3(tmp_path):
     assert rc == 3 and "needs a 4.3 GB shared-memory segment" in out and "/dev/shm has" in out, out
     rc, out, left = in_small_shm([ccommd, "--no-rt", "-n", "solo", "-c", cfg])
     assert rc == 3 and "needs a 4.3 GB" in out and "/dev/shm has" in out, out
-    assert left == "", "left in /dev/shm: " + left
+    assert left.split() == ["ccomm.solo.lock"], "left in /dev/shm: " + left  # the lock is tiny and stays
     # Room in /dev/shm, but an address-space limit of 1 GB (as a memory limit would).
     rc, out, left = in_small_shm([ccommd, "--no-rt", "-n", "solo", "-c", cfg], size="16g", limit_as=1 << 30)
     assert rc == 3 and "RLIMIT_AS" in out, out
-    assert "ccomm.solo" not in left, left
+    assert left.split() == ["ccomm.solo.lock"], left
 
 
 def test_pub_reads_values_as_signals_xml_does(tmp_path):
@@ -141,3 +140,40 @@ def test_summary_to_a_raw_node_without_mac_goes_to_every_station():
         r = run(pair.exec_prefix("planner") + ["python3", "-c", code], check=False, timeout=30)
         assert r.returncode == 0, "no summary from control: " + r.stderr
         assert int(r.stdout) == 0xFFFF, "summary dest %s" % r.stdout
+
+
+def foreign(pair, node):
+    return pair.stats(node)["counters"]["frames_foreign"]
+
+
+def test_ethertype_mismatch_is_logged_and_counted(tmp_path):
+    """control on EtherType 0x88B5, planner on 0x88B6: neither hears the other; both say why."""
+    with NodePair() as pair:
+        pair.start("control")
+        other = open(pair.config).read().replace('ethertype="0x88B5"', 'ethertype="0x88B6"')
+        assert 'ethertype="0x88B6"' in other
+        pair.config = write(tmp_path, "other.xml", other)
+        pair.start("planner")
+        assert wait_for(lambda: foreign(pair, "planner") > 0 and foreign(pair, "control") > 0, 10), \
+            (pair.stats("planner")["counters"], pair.log("planner"))
+        assert wait_for(lambda: "raw, EtherType 0x88B5" in pair.log("planner"), 5), pair.log("planner")
+        assert "it uses raw, EtherType 0x88B6" in pair.log("planner"), pair.log("planner")
+        assert "raw, EtherType 0x88B6" in pair.log("control"), pair.log("control")
+
+
+def test_transport_mismatch_is_logged_and_counted(tmp_path):
+    """control raw, planner UDP (--transport udp): each counts the other's frames as foreign."""
+    with NodePair() as pair:
+        pair.start("control")
+        pair.start("planner", extra=["--transport", "udp"])
+        assert wait_for(lambda: foreign(pair, "planner") > 0 and foreign(pair, "control") > 0, 10), \
+            (pair.stats("planner")["counters"], pair.stats("control")["counters"])
+        assert wait_for(lambda: "raw, EtherType 0x88B5" in pair.log("planner"), 5), pair.log("planner")
+        assert "over UDP to port 47800 from 10.42.0.2" in pair.log("control"), pair.log("control")
+        # A matched pair counts nothing.
+    with NodePair() as pair:
+        pair.start("control")
+        pair.start("planner")
+        assert wait_for(lambda: pair.stats("planner")["peers"][0]["alive"], 10)
+        time.sleep(0.5)
+        assert foreign(pair, "planner") == 0 and foreign(pair, "control") == 0

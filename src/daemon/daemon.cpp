@@ -116,8 +116,8 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   lock_fd_ = LockNode(store::SegmentName(self.name), gid, &holder);
   if (lock_fd_ == -EBUSY) {
     *error = "a ccommd for node '" + self.name + "' is already running (pid " +
-             (holder > 0 ? std::to_string(holder) : std::string("unknown")) + ", holding " +
-             store::SegmentName(self.name) + ".lock): stop it first (systemctl stop ccommd)";
+             (holder > 0 ? std::to_string(holder) : std::string("unknown")) + "; it holds " +
+             store::SegmentName(self.name) + ".lock, also while stopped): stop it first (systemctl stop ccommd)";
     return -EBUSY;
   }
   if (lock_fd_ < 0) {

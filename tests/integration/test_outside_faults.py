@@ -43,6 +43,7 @@ def test_stopped_ccommd_keeps_its_node_and_a_killed_one_is_readopted(tmp_path):
         pair.start("planner")
         first = pair.daemons["planner"]
         os.kill(first.pid, signal.SIGSTOP)
+        t0 = time.time()
         try:
             second = subprocess.Popen(pair.exec_prefix("planner") + [os.path.join(BIN, "ccommd"), "--node", "planner",
                                       "--no-rt", "-c", pair.config], env=pair.env, stdout=subprocess.PIPE,
@@ -54,13 +55,17 @@ def test_stopped_ccommd_keeps_its_node_and_a_killed_one_is_readopted(tmp_path):
                 out, _ = second.communicate()
                 raise AssertionError("a second ccommd took over a stopped one's node: " + out[-1500:])
         finally:
+            took = time.time() - t0
             os.kill(first.pid, signal.SIGCONT)
+        print("\nfigure: second ccommd next to a stopped one refused in %.0f ms, exit %s" % (took * 1000, second.returncode))
         assert second.returncode == 3, out
         assert "already running (pid %d" % first.pid in out, out
         assert first.poll() is None
         # A killed ccommd holds nothing: the next one starts at once and re-adopts.
         assert pair.stop("planner", signal.SIGKILL) == -signal.SIGKILL
+        t0 = time.time()
         pair.start("planner")
+        print("figure: after SIGKILL the next ccommd was serving in %.0f ms" % ((time.time() - t0) * 1000))
         assert wait_for(lambda: "re-adopted" in pair.log("planner"), 10), pair.log("planner")
 
 

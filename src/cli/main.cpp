@@ -184,7 +184,7 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
 int CmdPub(ccomm_client* c, int argc, char** argv) {
   double rate = 0;
   long count = 1;
-  // Options may come anywhere; words that are numbers ("-1.5") are values, not options.
+  // Options may come anywhere; words that are numbers ("-1.5", "-inf") are values, not options.
   std::vector<char*> pos;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -202,7 +202,7 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
       rate = strtod(a.c_str() + 7, nullptr);
     } else if (a.rfind("--count=", 0) == 0) {
       count = strtol(a.c_str() + 8, nullptr, 10);
-    } else if (a.size() > 1 && a[0] == '-' && !(isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')) {
+    } else if (a.size() > 1 && a[0] == '-' && !ccomm::cli::LooksLikeNumber(argv[i])) {
       fprintf(stderr, "ccomm pub: unknown option '%s'\n", a.c_str());
       return 2;
     } else {

@@ -10,6 +10,8 @@
 
 #include <vector>
 
+#include "config/text.h"
+
 namespace ccomm {
 namespace cli {
 
@@ -75,53 +77,26 @@ std::string FormatValue(const ccomm_signal_desc& d, const void* value) {
   return s + "]";
 }
 
+// The configuration's parser (safe_value) reads the same words the same way: one rule.
 static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* error) {
-  const char* s = w.c_str();
-  char* end = nullptr;
-  errno = 0;
-  switch (type) {
-    case CCOMM_BOOL:
-      if (w == "1" || w == "true") { *out = 1; return true; }
-      if (w == "0" || w == "false") { *out = 0; return true; }
-      *error = "'" + w + "' is not a bool (0, 1, true, false)";
-      return false;
-    case CCOMM_INT32: case CCOMM_INT64: {
-      // Decimal, or hexadecimal with 0x (as in signals.xml); a leading 0 is not octal.
-      int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) || (s[0] == '-' && s[1] == '0' && (s[2] == 'x' || s[2] == 'X')) ? 16 : 10;
-      long long v = strtoll(s, &end, base);
-      if (*s == '\0' || *end || errno || (type == CCOMM_INT32 && (v < INT32_MIN || v > INT32_MAX))) {
-        *error = "'" + w + "' is not a valid " + TypeName(type);
-        return false;
-      }
-      if (type == CCOMM_INT32) { int32_t x = static_cast<int32_t>(v); memcpy(out, &x, 4); }
-      else { int64_t x = v; memcpy(out, &x, 8); }
-      return true;
-    }
-    case CCOMM_UINT32: {
-      int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) ? 16 : 10;
-      unsigned long long v = strtoull(s, &end, base);
-      if (*s == '\0' || *s == '-' || *end || errno || v > UINT32_MAX) {
-        *error = "'" + w + "' is not a valid uint32";
-        return false;
-      }
-      uint32_t x = static_cast<uint32_t>(v);
-      memcpy(out, &x, 4);
-      return true;
-    }
-    case CCOMM_FLOAT: case CCOMM_DOUBLE: {
-      double v = strtod(s, &end);
-      if (*s == '\0' || *end || (errno == ERANGE && isinf(v))) {
-        *error = "'" + w + "' is not a number";
-        return false;
-      }
-      if (type == CCOMM_FLOAT) { float x = static_cast<float>(v); memcpy(out, &x, 4); }
-      else memcpy(out, &v, 8);
-      return true;
-    }
-    default:
-      *error = "unknown type";
-      return false;
+  using config_detail::NumResult;
+  if (type < CCOMM_BOOL || type > CCOMM_DOUBLE) {
+    *error = "unknown type";
+    return false;
   }
+  const NumResult r = config_detail::ParseValueElement(static_cast<ValueType>(type), w, out);
+  if (r == NumResult::kOk) return true;
+  if (r == NumResult::kRange) *error = "'" + w + "' is out of range for " + TypeName(type);
+  else if (type == CCOMM_BOOL) *error = "'" + w + "' is not a bool (0, 1, true, false)";
+  else *error = "'" + w + "' is not a valid " + TypeName(type);
+  return false;
+}
+
+bool LooksLikeNumber(const char* word) {
+  using config_detail::NumResult;
+  uint8_t v[8];
+  return config_detail::ParseValueElement(ValueType::kDouble, word, v) != NumResult::kSyntax ||
+         config_detail::ParseValueElement(ValueType::kInt64, word, v) != NumResult::kSyntax;  // -0x10
 }
 
 bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error) {

@@ -14,7 +14,10 @@ const char* TypeName(int type);
 std::string FormatValue(const ccomm_signal_desc& d, const void* value);
 /// Parses n words (one for all elements, or one per element; commas also separate).
 /// False with a message on any malformed or out-of-range word.
+/// Words are read as signals.xml reads a safe_value (config_detail::ParseValueElement).
 bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error);
+/// True if `word` is a number ("-1.5", "-inf", "-nan"): a value, not an option.
+bool LooksLikeNumber(const char* word);
 
 }  // namespace cli
 }  // namespace ccomm

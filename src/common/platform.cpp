@@ -94,7 +94,11 @@ int FileSize(int fd, size_t* size) {
   return 0;
 }
 
-int Truncate(int fd, size_t size) { return ftruncate(fd, static_cast<off_t>(size)) == 0 ? 0 : -errno; }
+int Truncate(int fd, size_t size) {
+  if (ftruncate(fd, static_cast<off_t>(size)) != 0) return -errno;
+  const int e = posix_fallocate(fd, 0, static_cast<off_t>(size));  // tmpfs undoes a failed one
+  return e == 0 || e == EOPNOTSUPP ? 0 : -e;
+}
 
 void CloseFd(int fd) {
   if (fd >= 0) close(fd);

@@ -44,7 +44,9 @@ int ShmUnlink(const char* name);                                   // 0 or -errn
 void* MapShared(int fd, size_t size);                              // nullptr on error (errno set)
 void Unmap(void* p, size_t size);
 int FileSize(int fd, size_t* size);                                // 0 or -errno
-int Truncate(int fd, size_t size);                                 // 0 or -errno
+/// Sizes a new shm object and allocates its backing (posix_fallocate): a /dev/shm too
+/// small fails here with -ENOSPC instead of a SIGBUS at the first touch. 0 or -errno.
+int Truncate(int fd, size_t size);
 void CloseFd(int fd);
 
 /// Locks current and future memory; returns 0 or -errno.

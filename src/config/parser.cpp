@@ -236,9 +236,10 @@ void Parser::Network(const Node* n, NetworkConfig* net) {
       Err(a->line, "invalid multicast_base " + Quote(a->value) + " (expected an IPv4 address like 239.255.67.0)");
     else if (q[0] < 224 || q[0] > 239)
       Err(a->line, "multicast_base " + a->value + " is not in 224.0.0.0/4");
-    else if (q[3] > 256 - kMaxNodes)
+    else if (q[3] > 255 - kMaxNodes)  // the node groups, then the summary group (kSummaryGroup)
       Err(a->line, "multicast_base " + a->value + ": its last byte must leave room for " +
-                       std::to_string(kMaxNodes) + " node groups (at most " + std::to_string(256 - kMaxNodes) + ")");
+                       std::to_string(kMaxNodes) + " node groups and the summary group (at most " +
+                       std::to_string(255 - kMaxNodes) + ")");
     else
       std::copy(q, q + 4, net->multicast_base);
   }

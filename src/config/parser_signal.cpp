@@ -174,58 +174,8 @@ void Parser::SafeValue(const AttrValue& a, SignalConfig* sig) {
   bytes.reserve(sig->value_bytes());
   const char* tname = ValueTypeName(sig->type);
   for (std::string_view item : items) {
-    std::string bad;  // "syntax" or "range"
-    switch (sig->type) {
-      case ValueType::kBool: {
-        bool b = false;
-        if (!ParseBool(item, &b)) bad = "syntax";
-        one[0] = b ? 1 : 0;
-        break;
-      }
-      case ValueType::kInt32:
-      case ValueType::kInt64: {
-        int64_t x = 0;
-        NumResult r = ParseI64(item, &x);
-        if (r == NumResult::kSyntax) bad = "syntax";
-        else if (r == NumResult::kRange) bad = "range";
-        if (sig->type == ValueType::kInt32) {
-          if (x < std::numeric_limits<int32_t>::min() || x > std::numeric_limits<int32_t>::max())
-            bad = bad.empty() ? "range" : bad;
-          int32_t y = static_cast<int32_t>(x);
-          std::memcpy(one.data(), &y, 4);
-        } else {
-          std::memcpy(one.data(), &x, 8);
-        }
-        break;
-      }
-      case ValueType::kUint32: {
-        uint64_t x = 0;
-        NumResult r = item.size() > 1 && item[0] == '-' ? NumResult::kRange : ParseU64(item, &x);
-        if (r == NumResult::kSyntax) bad = "syntax";
-        else if (r == NumResult::kRange || x > std::numeric_limits<uint32_t>::max()) bad = "range";
-        uint32_t y = static_cast<uint32_t>(x);
-        std::memcpy(one.data(), &y, 4);
-        break;
-      }
-      case ValueType::kFloat: {
-        float f = 0;
-        auto r = std::from_chars(item.data(), item.data() + item.size(), f);
-        if (r.ptr != item.data() + item.size()) bad = "syntax";
-        else if (r.ec == std::errc::result_out_of_range) bad = "range";
-        else if (r.ec != std::errc()) bad = "syntax";
-        std::memcpy(one.data(), &f, 4);
-        break;
-      }
-      case ValueType::kDouble: {
-        double d = 0;
-        auto r = std::from_chars(item.data(), item.data() + item.size(), d);
-        if (r.ptr != item.data() + item.size()) bad = "syntax";
-        else if (r.ec == std::errc::result_out_of_range) bad = "range";
-        else if (r.ec != std::errc()) bad = "syntax";
-        std::memcpy(one.data(), &d, 8);
-        break;
-      }
-    }
+    const NumResult r = ParseValueElement(sig->type, item, one.data());
+    const std::string bad = r == NumResult::kSyntax ? "syntax" : r == NumResult::kRange ? "range" : "";
     if (bad == "syntax") {
       const char* expect = sig->type == ValueType::kBool ? "true, false, 1 or 0"
                            : sig->type == ValueType::kFloat || sig->type == ValueType::kDouble

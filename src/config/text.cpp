@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -106,6 +107,58 @@ NumResult ParseI64(std::string_view s, int64_t* out, bool allow_hex) {
   if (mag > limit) return NumResult::kRange;
   *out = neg ? static_cast<int64_t>(0 - mag) : static_cast<int64_t>(mag);
   return NumResult::kOk;
+}
+
+namespace {
+template <typename T>
+NumResult ParseReal(std::string_view s, void* out) {
+  T v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || r.ptr != s.data() + s.size()) return NumResult::kSyntax;
+  if (r.ec == std::errc::result_out_of_range) return NumResult::kRange;
+  if (r.ec != std::errc()) return NumResult::kSyntax;
+  std::memcpy(out, &v, sizeof v);
+  return NumResult::kOk;
+}
+}  // namespace
+
+NumResult ParseValueElement(ValueType type, std::string_view s, void* out) {
+  switch (type) {
+    case ValueType::kBool: {
+      bool b = false;
+      if (!ParseBool(s, &b)) return NumResult::kSyntax;
+      const uint8_t byte = b ? 1 : 0;
+      std::memcpy(out, &byte, 1);
+      return NumResult::kOk;
+    }
+    case ValueType::kInt32:
+    case ValueType::kInt64: {
+      int64_t x = 0;
+      const NumResult r = ParseI64(s, &x);
+      if (r != NumResult::kOk) return r;
+      if (type == ValueType::kInt64) {
+        std::memcpy(out, &x, 8);
+        return NumResult::kOk;
+      }
+      if (x < std::numeric_limits<int32_t>::min() || x > std::numeric_limits<int32_t>::max()) return NumResult::kRange;
+      const int32_t y = static_cast<int32_t>(x);
+      std::memcpy(out, &y, 4);
+      return NumResult::kOk;
+    }
+    case ValueType::kUint32: {
+      if (s.size() > 1 && s[0] == '-') return NumResult::kRange;
+      uint64_t x = 0;
+      const NumResult r = ParseU64(s, &x);
+      if (r != NumResult::kOk) return r;
+      if (x > std::numeric_limits<uint32_t>::max()) return NumResult::kRange;
+      const uint32_t y = static_cast<uint32_t>(x);
+      std::memcpy(out, &y, 4);
+      return NumResult::kOk;
+    }
+    case ValueType::kFloat: return ParseReal<float>(s, out);
+    case ValueType::kDouble: return ParseReal<double>(s, out);
+  }
+  return NumResult::kSyntax;
 }
 
 // Non-negative decimal with up to `scale` fractional digits, returned multiplied by

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "common/value_type.h"
+
 namespace ccomm {
 namespace config_detail {
 
@@ -22,6 +24,12 @@ enum class NumResult { kOk, kSyntax, kRange };
 NumResult ParseU64(std::string_view s, uint64_t* out, bool allow_hex = true);
 /// Signed integer: optional '-', then as ParseU64.
 NumResult ParseI64(std::string_view s, int64_t* out, bool allow_hex = true);
+/// One element of a value of type `type` as the configuration (safe_value) and `ccomm
+/// pub` both read it: bool true/false/1/0; integers decimal or 0x hex ('-' for signed, no
+/// '+'); float and double in C syntax, inf and nan included (std::from_chars: no '+', no
+/// locale). kRange when it does not fit the type (a float overflows or underflows to
+/// 0/inf: never silently). Writes ValueTypeSize(type) bytes, host order, to `out`.
+NumResult ParseValueElement(ValueType type, std::string_view s, void* out);
 /// Non-negative decimal with up to `scale` fractional digits, times 10^scale.
 NumResult ParseFixed(std::string_view s, int scale, uint64_t* out);
 /// Items separated by blanks and/or single commas; false on an empty item.

@@ -89,6 +89,9 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   }
 
   if (fanout_multicast_ && !groups.empty()) {
+    // Every node's summary goes to the summary group, which every node with a socket
+    // joins: any board sees the whole system (ccomm stats --all), not only its peers.
+    if (cfg.network.summary_ms != 0) groups.push_back(GroupAddressFor(cfg.network, kSummaryGroup, kind));
     PeerTx& g = peers_tx_[group_tx_];
     g.active = g.sends = true;
     g.dest = wire::kDestAll;
@@ -109,10 +112,23 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
   // Two ccommd for one node would both forward and reclaim in one segment: refuse the
   // second (a systemd unit and a hand-started one, say) before it touches anything.
-  if (const int other = RunningDaemonOf(store::SegmentName(self.name))) {
-    *error = "a ccommd for node '" + self.name + "' is already running (pid " + std::to_string(other) +
-             "): stop it first (systemctl stop ccommd)";
+  int holder = 0;
+  lock_fd_ = LockNode(store::SegmentName(self.name), gid, &holder);
+  if (lock_fd_ == -EBUSY) {
+    *error = "a ccommd for node '" + self.name + "' is already running (pid " +
+             (holder > 0 ? std::to_string(holder) : std::string("unknown")) + "; it holds " +
+             store::SegmentName(self.name) + ".lock, also while stopped): stop it first (systemctl stop ccommd)";
     return -EBUSY;
+  }
+  if (lock_fd_ < 0) {
+    const int e = lock_fd_;
+    *error = "cannot lock " + store::SegmentName(self.name) + ".lock: " + strerror(-e);
+    return e;
+  }
+  const std::string fit = SegmentFitProblem(cfg, node_id, store::SegmentName(self.name));
+  if (!fit.empty()) {
+    *error = fit;
+    return -ENOSPC;
   }
   int r = CreateOrAdoptSegment(&segment_, cfg, node_id, store::SegmentName(self.name), gid, &adopted_, error);
   if (r != 0) return r;
@@ -148,6 +164,11 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
       r = transport_.JoinGroups(groups.data(), groups.size(), error);
       if (r != 0) return r;
     }
+    // Before the capabilities go: the watch needs CAP_NET_RAW (a UDP node may lack it).
+    const int fr = foreign_.Open(cfg.network, self, kind);
+    if (fr != 0)
+      Log(LogLevel::kInfo, "not watching for frames of other transports/EtherTypes (%s): a mismatched board "
+          "shows only as a peer that never comes up", strerror(-fr));
   }
   r = view_.Start(cfg, node_id, kind, opt.force_udp, &segment_, &transport_, &auth_, gid, error);
   if (r != 0) return r;
@@ -179,6 +200,8 @@ void Daemon::Supervise(uint64_t now) {
       socket_drops_seen_ = drops;
     }
   }
+  if (const uint32_t foreign = foreign_.Poll(now))
+    h->daemon_counters[store::kFramesForeign].fetch_add(foreign, std::memory_order_relaxed);
   for (uint32_t p = 0; p < peers_rx_.size(); ++p) {
     if (!peers_tx_[p].active) continue;
     store::PeerStats& ps = segment_.peer(p);
@@ -228,11 +251,14 @@ void Daemon::RequestStop() {
 void Daemon::Shutdown() {
   running_.store(false);
   transport_.Close();
+  foreign_.Close();
   view_.Stop();
   if (segment_.is_open()) {
     segment_.header()->daemon_pid.store(0, std::memory_order_release);
     segment_.Close();  // the segment stays: clients keep reading (stale) values
   }
+  platform::CloseFd(lock_fd_);  // the next ccommd of this node may start
+  lock_fd_ = -1;
 }
 
 }  // namespace ccomm

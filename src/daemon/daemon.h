@@ -12,6 +12,7 @@
 
 #include "config/config.h"
 #include "daemon/auth.h"
+#include "daemon/foreign_frames.h"
 #include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
@@ -168,10 +169,12 @@ class Daemon {
   uint32_t self_ = 0;
   DaemonOptions opt_;
   store::Segment segment_;
+  int lock_fd_ = -1;  // the node's lock (LockNode), held while this ccommd lives
   bool adopted_ = false;
   Transport transport_;
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
   SystemView view_;                        // node summaries: ccomm stats --all (system_view.h)
+  ForeignFrameWatch foreign_;              // mismatched boards' frames (foreign_frames.h)
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};

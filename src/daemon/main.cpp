@@ -18,6 +18,7 @@
 #include "daemon/node_identity.h"
 #include "daemon/privileges.h"
 #include "daemon/sd_notify.h"
+#include "daemon/segment_builder.h"
 #include "store/layout.h"
 #include "wire/wire.h"
 
@@ -118,6 +119,15 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (opt.check_only) {
+    // A valid file can still need more shared memory than this machine gives (queue_depth
+    // x size adds up): say so now, not with a SIGBUS at start (exit 3, as start would).
+    for (uint32_t i = 0; i < cfg.nodes.size(); ++i) {
+      const std::string fit = SegmentFitProblem(cfg, i, store::SegmentName(cfg.nodes[i].name));
+      if (!fit.empty()) {
+        fprintf(stderr, "%s: error: %s\n", opt.config_path.c_str(), fit.c_str());
+        return 3;
+      }
+    }
     printf("%s: ok (%zu nodes, %zu signals, hash %08x)\n", opt.config_path.c_str(), cfg.nodes.size(),
            cfg.signals.size(), cfg.hash);
     return 0;

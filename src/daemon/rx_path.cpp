@@ -27,7 +27,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
   PeerRx& pr = peers_rx_[h.sender];
   FrameStream& fs = pr.stream[h.dest == wire::kDestAll ? 1 : 0];
   const int32_t d = static_cast<int32_t>(h.seq - fs.expected);  // serial arithmetic
-  bool resync = false;
+  bool resync = false, restarted = false;
   if (!fs.seen || d == 0) {
     fs.seen = true;
   } else if (d > 0) {
@@ -38,7 +38,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
     // back after a silence longer than the sender's clock is old: the board rebooted in
     // the meantime. (A frame that is merely late, even after a silence, was sent on an
     // older clock than that: it must not roll the values back.)
-    resync = true;
+    resync = restarted = true;
   } else if (d < -kResyncDistance && ++fs.behind >= kResyncAfter) {
     resync = true;  // the stored position is wrong (see kResyncAfter)
   } else {
@@ -47,8 +47,13 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
     return;
   }
   if (resync) {
-    Log(LogLevel::kNotice, "peer '%s': frame sequence resynchronised (seq %u, expected %u)",
-        cfg_->nodes[h.sender].name.c_str(), h.seq, fs.expected);
+    // The operator's two cases (ccommd(8)): a restart is routine, a jump is not.
+    if (restarted)
+      Log(LogLevel::kNotice, "peer '%s' restarted (frame seq %u, expected %u)", cfg_->nodes[h.sender].name.c_str(),
+          h.seq, fs.expected);
+    else
+      Log(LogLevel::kNotice, "peer '%s': frame sequence resynchronised (seq %u, expected %u)",
+          cfg_->nodes[h.sender].name.c_str(), h.seq, fs.expected);
     // Its value sequence numbers may restart too: rule 6 follows them (readers keep a
     // growing seq, see SignalRx).
     for (size_t i = 0; i < rx_signals_.size(); ++i)

@@ -17,10 +17,19 @@ size_t SegmentSize(const SystemConfig& cfg, uint32_t node_id);
 /// Builds the complete segment image for `cfg` as seen by `node_id` into `mem` (size
 /// from SegmentSize). Used for creation and to compare with an existing segment.
 void BuildSegment(const SystemConfig& cfg, uint32_t node_id, void* mem, size_t size);
-/// The pid of another ccommd that serves segment `name` now (its heartbeat advances
-/// within 100 ms), else 0. A ccommd that stopped cleanly cleared its pid (no wait); a
-/// killed one left it, and its heartbeat stands still: then this waits the 100 ms.
-int RunningDaemonOf(const std::string& name);
+/// "" if node `node_id`'s segment (named `name`) can be created on this machine, else a
+/// one-line cause with the fix: room in /dev/shm (not needed to re-adopt a segment of the
+/// same size), the cgroup's memory.max and RLIMIT_AS (twice the size: the image is built
+/// in memory first), the address space. Checked by --check and before creating it.
+std::string SegmentFitProblem(const SystemConfig& cfg, uint32_t node_id, const std::string& name);
+/// Takes node `segment_name`'s lock: a POSIX record lock on the shared-memory object
+/// "<segment_name>.lock", held as long as this process lives, also while it is stopped
+/// (SIGSTOP: a heartbeat would stand still), and dropped by the kernel when it dies
+/// (SIGKILL, crash), so a restart never waits. The object is never removed: removing it
+/// would let two daemons lock two different files. Returns the fd to keep open (>= 0);
+/// -EBUSY if another process holds it (its pid in *holder_pid when the kernel says);
+/// another -errno if the object cannot be opened.
+int LockNode(const std::string& segment_name, int gid, int* holder_pid);
 /// Builds the image and creates or re-adopts the segment `name` from it (see
 /// store::Segment::CreateOrAdopt).
 int CreateOrAdoptSegment(store::Segment* segment, const SystemConfig& cfg, uint32_t node_id,

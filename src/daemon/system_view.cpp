@@ -86,7 +86,10 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
     if (cfg.network.fanout == Fanout::kMulticast) continue;  // one frame to our group, below
     Dest d;
     if (!PeerAddressFor(cfg.network, cfg.nodes[p], kind, &d.addr)) continue;  // unreachable: no summary
-    d.dest = static_cast<uint16_t>(p);
+    // A raw node without mac= is reached by Ethernet broadcast: every station gets the
+    // frame, so it says so (protocol.md, "Node summary"), also when that node is the only one.
+    const bool broadcast = kind == TransportKind::kRaw && !cfg.nodes[p].has_mac;
+    d.dest = broadcast ? wire::kDestAll : static_cast<uint16_t>(p);
     bool shared = false;
     for (Dest& o : dests_) {
       if (SameAddress(o.addr, d.addr, kind)) {  // broadcast MAC or a shared group: send once to all
@@ -97,10 +100,9 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
     if (!shared) dests_.push_back(d);
   }
   if (cfg.network.fanout == Fanout::kMulticast && cfg.network.summary_ms != 0 && transport->ops != nullptr) {
-    // Multicast fan-out: once to this node's group, like its data; the nodes that exchange
-    // signals with it (monitor nodes included) joined that group.
+    // Multicast fan-out: once to the summary group, which every node joined (daemon.cpp).
     Dest d;
-    d.addr = GroupAddressFor(cfg.network, self, kind);
+    d.addr = GroupAddressFor(cfg.network, kSummaryGroup, kind);
     d.dest = wire::kDestAll;
     dests_.push_back(d);
   }
@@ -235,6 +237,8 @@ SystemView::Verdict SystemView::Receive(const uint8_t* frame, const wire::FrameH
                                         const PeerAddress& from) {
   store::ViewHeader* vh = view_.mutable_header();
   Verdict v = Verdict::kApplied;
+  if (h.sender == self_ && senders_[self_].ipv4 && from.ipv4 == senders_[self_].ipv4 && h.dest == wire::kDestAll)
+    return Verdict::kOwn;
   if (h.sender >= senders_.size() || h.sender == self_) v = Verdict::kUnknownSender;
   else if (senders_[h.sender].ipv4 && from.ipv4 != senders_[h.sender].ipv4) v = Verdict::kWrongSource;
   else if (h.dest != self_ && h.dest != wire::kDestAll) v = Verdict::kNotForUs;
@@ -306,6 +310,7 @@ void Daemon::HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint6
   switch (view_.Receive(buf, h, now, from)) {
     case SystemView::Verdict::kApplied: Count(store::kFramesRx, std::memory_order_release); break;
     case SystemView::Verdict::kOld: Count(store::kFramesRx); break;  // a duplicate, like data ones
+    case SystemView::Verdict::kOwn: break;
     case SystemView::Verdict::kUnknownSender: Count(store::kFramesUnknownSender); break;
     case SystemView::Verdict::kWrongSource: Count(store::kFramesWrongSource); break;
     case SystemView::Verdict::kNotForUs: Count(store::kFramesNotForUs); break;

@@ -26,7 +26,9 @@ class SystemView {
  public:
   /// What Receive() did with a summary frame; the daemon counts the refusals in its
   /// usual counters (same meaning as for data frames).
-  enum class Verdict { kApplied, kOld, kUnknownSender, kWrongSource, kNotForUs, kWrongHash, kUnknownSignal };
+  /// kOwn: this node's own summary, looped back by the summary group (UDP multicast
+  /// loops back so nodes sharing a host hear each other): ignored, not counted.
+  enum class Verdict { kApplied, kOld, kOwn, kUnknownSender, kWrongSource, kNotForUs, kWrongHash, kUnknownSignal };
 
   /// Creates the view object; `transport`/`auth` may be unusable (local-only node: the
   /// view then holds this node only). 0 or -errno with `error`.

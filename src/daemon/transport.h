@@ -72,6 +72,10 @@ int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
 /// Multicast fan-out: the group node `node_id` sends to (docs/protocol.md, "Fan-out"):
 /// raw MAC 03:63:63:6d:00:ID, UDP multicast_base + ID on udp_port.
 PeerAddress GroupAddressFor(const NetworkConfig& net, uint32_t node_id, TransportKind kind);
+/// The group every node joins with fanout="multicast" and summaries on (summary_ms > 0):
+/// node summaries go there, so `ccomm stats --all` sees every node from any board, not
+/// only those it exchanges signals with (raw MAC 03:63:63:6d:00:40, UDP multicast_base + 64).
+constexpr uint32_t kSummaryGroup = kMaxNodes;
 /// First four bytes of every group MAC (a locally administered multicast prefix, "ccm").
 constexpr uint8_t kGroupMacPrefix[4] = {0x03, 0x63, 0x63, 0x6d};
 

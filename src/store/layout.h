@@ -25,7 +25,7 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 6;
+constexpr uint32_t kLayoutVersion = 7;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
@@ -69,7 +69,7 @@ struct alignas(kCacheLine) SegmentHeader {
   std::atomic<uint32_t> rx_waiters;
 
   // Daemon-wide counters (frames rejected by reason etc.), see DaemonStats.
-  alignas(kCacheLine) std::atomic<uint64_t> daemon_counters[16];
+  alignas(kCacheLine) std::atomic<uint64_t> daemon_counters[32];
 };
 
 enum DaemonCounter : uint32_t {
@@ -78,9 +78,10 @@ enum DaemonCounter : uint32_t {
   kEntriesWrongType, kSendErrors, kTxWakeups, kRecvErrors, kSlotsReclaimed,
   kSocketDrops,  // frames the kernel dropped at ccommd's socket (receive buffer full)
   kFramesWrongSource,  // UDP frames whose source address is not the sender's configured one
+  kFramesForeign,  // ccomm frames of another transport, EtherType or UDP port (foreign_frames.h)
   kDaemonCounterCount
 };
-static_assert(kDaemonCounterCount <= 16, "daemon_counters has 16 entries");
+static_assert(kDaemonCounterCount <= 32, "daemon_counters has 32 entries");
 
 enum SignalFlags : uint32_t {
   kSigEvent = 1u << 0,         // event signal (ring) rather than state (slots)

@@ -118,7 +118,7 @@ class NodePair:
         for ns in self.ns.values():
             run(["ip", "netns", "del", ns], check=False)
         for node in self.ns:
-            for suffix in ("", ".view"):  # the segment and the system view (ccomm stats --all)
+            for suffix in ("", ".view", ".lock"):  # the segment, the system view, the node lock
                 path = "/dev/shm/" + self.env["CCOMM_SHM_PREFIX"].lstrip("/") + node + suffix
                 if os.path.exists(path):
                     os.unlink(path)

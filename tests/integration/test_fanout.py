@@ -89,3 +89,27 @@ def test_fanout(transport, fanout):
             # A consumer does not count the group entries it skips as errors.
             for n in ("c1", "c2", "m"):
                 assert counter(nodes.stats(n), "frames_not_for_us") == 0, (n, nodes.stats(n)["counters"])
+
+
+def test_consumer_of_more_producers_than_one_socket_may_join():
+    """fanout="multicast" over UDP: a node consuming from 22 producers joins 23 groups
+    (22 + the summary group), more than Linux lets one socket join
+    (net.ipv4.igmp_max_memberships, 20 by default). It starts and hears the first and
+    the last producer (whose groups land on different sockets)."""
+    producers = ["p%02d" % i for i in range(22)]
+    names = ["c"] + producers
+    xml = ['<?xml version="1.0"?>', '<ccomm version="1">',
+           '  <network fanout="multicast" heartbeat_ms="100" peer_timeout_ms="1000"/>']
+    for i, n in enumerate(names):
+        xml.append('  <node name="%s" ip="%s" transport="udp"/>' % (n, Nodes.ip_of(i)))
+    for p in producers:
+        xml.append('  <signal name="%s_out" type="double" producer="%s" consumers="c" stale_after_ms="1000"/>' % (p, p))
+    xml.append("</ccomm>\n")
+    with Nodes(names, "\n".join(xml)) as nodes:
+        nodes.start("c")
+        for p in (producers[0], producers[-1]):
+            nodes.start(p)
+            nodes.spawn(p, "pub", p + "_out", "2.5", "--rate", "50", "--count", "100000")
+        for p in (producers[0], producers[-1]):
+            assert wait_for(lambda: nodes.echo_once("c", p + "_out") == ("2.5", "fresh"), 10), \
+                (p, nodes.log("c"), nodes.stats("c")["counters"])

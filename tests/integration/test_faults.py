@@ -110,7 +110,7 @@ def test_second_ccommd_for_a_node_is_refused_and_a_clean_stop_removes_the_view()
                                                     "-c", pair.config], check=False, env=pair.env, timeout=10)
         took = time.time() - t0
         assert second.returncode != 0, second.stdout + second.stderr
-        assert "already running (pid %d)" % first in second.stdout + second.stderr, second.stdout + second.stderr
+        assert "already running (pid %d;" % first in second.stdout + second.stderr, second.stdout + second.stderr
         assert pair.daemons["planner"].poll() is None
         assert wait_for(lambda: pair.echo_once("planner", "wheel0_pos") == ("4.5", "fresh"), 1)
         assert pair.stats("planner")["daemon_alive"]

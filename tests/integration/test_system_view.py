@@ -106,7 +106,7 @@ def system(tmp_path, request):
                     p.wait()
         run(["ip", "netns", "del", ns], check=False)
         for node in "abc":
-            for suffix in ("", ".view"):
+            for suffix in ("", ".view", ".lock"):
                 path = "/dev/shm/" + prefix.lstrip("/") + node + suffix
                 if os.path.exists(path):
                     os.unlink(path)
@@ -359,6 +359,43 @@ def test_monitor_node_sees_the_system_over_multicast(transport):
             c = nodes.stats(n)["counters"]
             for name in ("frames_bad", "frames_unknown_sender", "frames_not_for_us", "frames_wrong_source",
                          "entries_unknown_signal"):
+                assert c[name] == 0, (n, name, c)
+
+
+DISJOINT = ["a1", "a2", "b1", "b2"]
+
+
+@pytest.mark.parametrize("transport", ["raw", "udp"])
+def test_every_node_seen_from_any_board_over_multicast(transport):
+    """fanout="multicast" with two pairs that exchange nothing with each other (a1 -> a2,
+    b1 -> b2): from any board `ccomm stats --all` shows all four nodes alive, as README
+    and usage.md promise (summaries go to the summary group every node joins)."""
+    nodes_xml = []
+    for i, n in enumerate(DISJOINT):
+        addr = 'interface="eth0"' if transport == "raw" else 'ip="%s"' % Nodes.ip_of(i)
+        nodes_xml.append('  <node name="%s" transport="%s" %s/>' % (n, transport, addr))
+    cfg = """<?xml version="1.0"?>
+<ccomm version="1">
+  <network fanout="multicast" heartbeat_ms="100" peer_timeout_ms="%d" summary_ms="%d"/>
+%s
+  <signal name="a_sig" type="double" producer="a1" consumers="a2"/>
+  <signal name="b_sig" type="double" producer="b1" consumers="b2"/>
+</ccomm>
+""" % (PEER_TIMEOUT_MS, SUMMARY_MS, "\n".join(nodes_xml))
+    with Nodes(DISJOINT, cfg) as nodes:
+        for n in DISJOINT:
+            nodes.start(n)
+
+        def alive_seen_from(board):
+            v = nodes_of(json.loads(nodes.cli(board, "stats", "--all", "--json").stdout))
+            return sorted(n for n in v if v[n]["alive"])
+
+        for board in DISJOINT:
+            assert wait_for(lambda: alive_seen_from(board) == sorted(DISJOINT), 5 * SLACK), \
+                (board, alive_seen_from(board))
+        for n in DISJOINT:
+            c = nodes.stats(n)["counters"]
+            for name in ("frames_bad", "frames_unknown_sender", "frames_not_for_us", "frames_wrong_source"):
                 assert c[name] == 0, (n, name, c)
 
 

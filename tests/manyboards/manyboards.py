@@ -394,7 +394,10 @@ def system(args):
         if args.kill:
             victim = 1 % n
             vname = config.board(victim)
-            kill_seconds = 4.0
+            # The apps run on well past the restart: on a loaded machine reaping, the 1 s pause
+            # and the restarted ccommd's start-up can take seconds (CI saw the apps end before
+            # the restarted ccommd was up, so "fresh again" could not be seen).
+            kill_seconds = 7.0
             start_at, apps = run_apps(r, nodes, kill_seconds)
             time.sleep(max(0.0, (start_at - time.monotonic_ns()) / 1e9) + 1.5)
             t_kill = time.monotonic_ns()

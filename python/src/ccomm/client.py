@@ -47,12 +47,23 @@ class Status(enum.IntEnum):
 
 
 class SignalType(enum.IntEnum):
+    """ccomm_type; a type's name (ccomm_type_name) is its member name in lower case."""
+
     BOOL = 1
     INT32 = 2
     UINT32 = 3
     INT64 = 4
     FLOAT = 5
     DOUBLE = 6
+
+    @property
+    def type_name(self) -> str:
+        """"bool", "int32", ... "double": the name signals.xml and ccomm(1) use."""
+        return self.name.lower()
+
+
+#: Status names as recordings and ccomm(1) write them: "fresh", "stale", "never", "empty".
+STATUS_NAMES = tuple(s.name.lower() for s in Status)
 
 
 _DTYPES: Dict[SignalType, "np.dtype[Any]"] = {
@@ -64,8 +75,16 @@ _DTYPES: Dict[SignalType, "np.dtype[Any]"] = {
     SignalType.DOUBLE: np.dtype(np.float64),
 }
 
+# struct format of one element of each type (little-endian: the segment is host order,
+# and every board ccomm runs on is little-endian)
+STRUCT_CODES: Dict[SignalType, str] = {
+    SignalType.BOOL: "?", SignalType.INT32: "i", SignalType.UINT32: "I", SignalType.INT64: "q",
+    SignalType.FLOAT: "f", SignalType.DOUBLE: "d",
+}
+#: the same by type name ("double": "d"), for what recordings name
+TYPE_FORMATS: Dict[str, str] = {t.type_name: code for t, code in STRUCT_CODES.items()}
+
 _SAFE_VALUE = 0x1  # CCOMM_INFO_SAFE_VALUE
-_NO_DOORBELL = 0x1  # CCOMM_OPEN_NO_DOORBELL
 
 
 @dataclass(frozen=True)
@@ -81,10 +100,26 @@ class SignalInfo:
     produced_here: bool  #: this node may write it
     stale_after_ms: int  #: 0 = never stale
     producer: str
+    consumed_here: bool = False  #: produced elsewhere and delivered to this node
 
     @property
     def dtype(self) -> "np.dtype[Any]":
         return _DTYPES[self.type]
+
+    @property
+    def type_name(self) -> str:
+        """"double", "int32", ...: the element type's name."""
+        return self.type.type_name
+
+    @property
+    def type_text(self) -> str:
+        """"double" for a scalar, "double[4]" for an array."""
+        return self.type_name if self.count == 1 else f"{self.type_name}[{self.count}]"
+
+    @property
+    def readable_here(self) -> bool:
+        """This node holds values of the signal (it produces or receives it)."""
+        return self.produced_here or self.consumed_here
 
 
 @dataclass(frozen=True)
@@ -230,6 +265,19 @@ class Signal:
         from .history import History
         return History(self, back)
 
+    @property
+    def history_depth(self) -> int:
+        """Values of this signal the node's history tap keeps (0: none, see <node history=>)."""
+        return max(0, int(_native.lib().ccomm_history_depth(self._client._handle(), self.info.id)))
+
+    def stats(self) -> Dict[str, int]:
+        """ccommd's counters of this signal on this node (ccomm_signal_stats: writes, tx,
+        coalesced, rx, lost, stale, ...; what `ccomm stats` prints per signal)."""
+        out = _native.SignalStats()
+        _check(_native.lib().ccomm_get_signal_stats(self._client._handle(), self.info.id, ctypes.byref(out)),
+               f"stats of {self.info.name}")
+        return {name: int(getattr(out, name)) for name, _t in out._fields_}
+
     def read_into(self, out: npt.NDArray[Any]) -> Reading:
         """Reads into `out` (shape (count,), the signal's dtype), allocating no array.
         The Reading's value is `out` (None for EMPTY; `out` then keeps its contents)."""
@@ -277,13 +325,16 @@ class Client:
     are not shared between threads). Closes on exit of a `with` block."""
 
     def __init__(self, node: Optional[str] = None, *, no_doorbell: bool = False,
-                 check_daemon: bool = True) -> None:
+                 batch: bool = False, check_daemon: bool = True) -> None:
         """Attaches to `node` (None: $CCOMM_NODE, else the hostname); NotFoundError if
         its ccommd has not made the segment. With check_daemon (the default), a write
-        while ccommd is not running raises DaemonNotRunningError after writing."""
+        while ccommd is not running raises DaemonNotRunningError after writing. With
+        batch, state writes are held until flush() and then leave together (one frame
+        per control step: CCOMM_OPEN_BATCH)."""
         self._h: Optional[int] = None
-        self._h = self._open(node, _NO_DOORBELL if no_doorbell else 0)
-        self._node_arg, self._flags, self._check_daemon = node, _NO_DOORBELL if no_doorbell else 0, check_daemon
+        flags = (_native.OPEN_NO_DOORBELL if no_doorbell else 0) | (_native.OPEN_BATCH if batch else 0)
+        self._h = self._open(node, flags)
+        self._node_arg, self._flags, self._check_daemon = node, flags, check_daemon
         self._signals: Dict[str, Signal] = {}
         self._waiter: Optional[int] = None  # the handle Signal.wait() waits on
         self._pump = _aio.ChangePump(lambda: self._open(self._node_arg, self._flags))
@@ -301,6 +352,17 @@ class Client:
         if self._h is None:
             raise ValueError("ccomm client is closed")
         return self._h
+
+    @property
+    def handle(self) -> int:
+        """The ccomm_client* as an address, for direct calls through ccomm._native.lib()
+        (the record and replay loops); valid until close()."""
+        return self._handle()
+
+    def flush(self) -> None:
+        """Batch client (Client(batch=True)): hands every state value written since the
+        last flush to ccommd at once (ccomm_flush); otherwise does nothing."""
+        _check(_native.lib().ccomm_flush(self._handle()), "flush")
 
     @property
     def node(self) -> str:
@@ -338,7 +400,8 @@ class Client:
         return SignalInfo(id=sid, name=(d.name or b"").decode(), type=SignalType(d.type),
                           count=int(d.count), value_bytes=int(d.value_bytes),
                           is_event=bool(d.is_event), produced_here=bool(d.produced_here),
-                          stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode())
+                          stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode(),
+                          consumed_here=bool(d.consumed_here))
 
     def signals(self) -> List[SignalInfo]:
         """Every signal of the system, in configuration order."""

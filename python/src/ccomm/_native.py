@@ -260,14 +260,19 @@ def library_path() -> str:
 def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
     vp, cp, i32, u32, i64 = ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int32, ctypes.c_uint32, ctypes.c_int64
     sz, c_int = ctypes.c_size_t, ctypes.c_int
-    # name: (argument types, result type); every struct pointer is vp (see the docstring)
+    # name: (argument types, result type); every struct pointer is vp (see the docstring).
+    # The growable structs are filled by the *_sized calls, given ctypes.sizeof of the
+    # structure here (ccomm.h, "Growable structs"): a newer library never writes past it.
     api: Dict[str, Any] = {
         "ccomm_open": ([cp, u32, ctypes.POINTER(vp)], c_int),
         "ccomm_close": ([vp], None),
         "ccomm_strerror": ([c_int], cp),
+        "ccomm_type_name": ([i32], cp),
+        "ccomm_type_size": ([i32], u32),
+        "ccomm_type_from_name": ([cp], c_int),
         "ccomm_find": ([vp, cp], i32),
         "ccomm_signal_count": ([vp], c_int),
-        "ccomm_describe": ([vp, i32, vp], c_int),
+        "ccomm_describe_sized": ([vp, i32, vp, sz], c_int),
         "ccomm_node_name": ([vp], cp),
         "ccomm_read": ([vp, i32, vp, sz, vp], c_int),
         "ccomm_write": ([vp, i32, vp, sz], c_int),
@@ -277,14 +282,14 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_set_time": ([vp, i64], c_int),
         "ccomm_now": ([], i64),
         "ccomm_daemon_alive": ([vp], c_int),
-        "ccomm_get_signal_stats": ([vp, i32, vp], c_int),
+        "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),
         "ccomm_node_count": ([vp], c_int),
-        "ccomm_get_peer_stats": ([vp, c_int, vp], c_int),
+        "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
-        "ccomm_view_get_node": ([vp, c_int, vp], c_int),
-        "ccomm_view_get_signal": ([vp, c_int, i32, vp], c_int),
-        "ccomm_view_get_counters": ([vp, vp], c_int),
+        "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),
+        "ccomm_view_get_signal_sized": ([vp, c_int, i32, vp, sz], c_int),
+        "ccomm_view_get_counters_sized": ([vp, vp, sz], c_int),
         "ccomm_history_depth": ([vp, i32], c_int),
         "ccomm_history_start": ([vp, i32, u32, vp], c_int),
         "ccomm_history_read": ([vp, i32, vp, vp, sz, vp], c_int),

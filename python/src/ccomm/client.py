@@ -274,7 +274,8 @@ class Signal:
         """ccommd's counters of this signal on this node (ccomm_signal_stats: writes, tx,
         coalesced, rx, lost, stale, ...; what `ccomm stats` prints per signal)."""
         out = _native.SignalStats()
-        _check(_native.lib().ccomm_get_signal_stats(self._client._handle(), self.info.id, ctypes.byref(out)),
+        _check(_native.lib().ccomm_get_signal_stats_sized(self._client._handle(), self.info.id, ctypes.byref(out),
+                                                          ctypes.sizeof(out)),
                f"stats of {self.info.name}")
         return {name: int(getattr(out, name)) for name, _t in out._fields_}
 
@@ -396,7 +397,8 @@ class Client:
 
     def _describe(self, sid: int) -> SignalInfo:
         d = _native.SignalDesc()
-        _check(_native.lib().ccomm_describe(self._handle(), sid, ctypes.byref(d)), f"describe {sid}")
+        _check(_native.lib().ccomm_describe_sized(self._handle(), sid, ctypes.byref(d), ctypes.sizeof(d)),
+               f"describe {sid}")
         return SignalInfo(id=sid, name=(d.name or b"").decode(), type=SignalType(d.type),
                           count=int(d.count), value_bytes=int(d.value_bytes),
                           is_event=bool(d.is_event), produced_here=bool(d.produced_here),

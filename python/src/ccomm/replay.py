@@ -126,11 +126,12 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
     # late and steps follow each other within ccommd's wake-up time.
     stats = _native.SignalStats()
     stats_addr = ctypes.addressof(stats)
-    get_stats, raw_flush = L.ccomm_get_signal_stats, L.ccomm_flush
+    get_stats, raw_flush = L.ccomm_get_signal_stats_sized, L.ccomm_flush
+    stats_size = ctypes.sizeof(stats)
     probe = [-1, 0]  # a signal of the last flushed step, its tx before that flush
 
     def tx_of(sid: int) -> int:
-        get_stats(handle, sid, stats_addr)
+        get_stats(handle, sid, stats_addr, stats_size)
         return int(stats.tx)
 
     no_tx: "set[int]" = set()  # signals ccommd did not send within the bound (not forwarded): no probe

@@ -61,6 +61,11 @@ class SignalType(enum.IntEnum):
         """"bool", "int32", ... "double": the name signals.xml and ccomm(1) use."""
         return self.name.lower()
 
+    @property
+    def json_type(self) -> str:
+        """The JSON Schema type of a value: boolean, integer or number."""
+        return {"b": "boolean", "f": "number"}.get(_DTYPES[self].kind, "integer")
+
 
 #: Status names as recordings and ccomm(1) write them: "fresh", "stale", "never", "empty".
 STATUS_NAMES = tuple(s.name.lower() for s in Status)

@@ -88,8 +88,8 @@ typedef struct ccomm_info {
 typedef enum ccomm_type {
   CCOMM_BOOL = 1, CCOMM_INT32 = 2, CCOMM_UINT32 = 3, CCOMM_INT64 = 4, CCOMM_FLOAT = 5, CCOMM_DOUBLE = 6
 } ccomm_type;
-/** "bool", "int32", "uint32", "int64", "float" or "double", as signals.xml writes the
- *  ccomm_type; NULL for another value. Tools take type names from here. */
+/** The name of a ccomm_type as signals.xml writes it (bool, int32, uint32, int64, float,
+ *  double); NULL for another value. Tools take type names from here. */
 CCOMM_API const char* ccomm_type_name(int32_t type);
 /** Bytes of one element of a ccomm_type (bool: 1); 0 for another value. */
 CCOMM_API uint32_t ccomm_type_size(int32_t type);

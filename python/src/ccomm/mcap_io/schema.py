@@ -43,9 +43,6 @@ FORMAT_VERSION = "1"
 RECORD = struct.Struct("<HBBQqQQ")
 FLAG_SAFE_VALUE = 0x1
 
-_JSON_TYPES = {"bool": "boolean", "int32": "integer", "uint32": "integer", "int64": "integer",
-               "float": "number", "double": "number"}
-
 
 def schema_name(desc: SignalInfo) -> str:
     return SCHEMA_PREFIX + desc.type_text
@@ -53,7 +50,7 @@ def schema_name(desc: SignalInfo) -> str:
 
 def json_schema(desc: SignalInfo) -> bytes:
     """JSON Schema of one signal's messages (one schema per type and count)."""
-    elem: Dict[str, Any] = {"type": [_JSON_TYPES[desc.type_name], "null"]}
+    elem: Dict[str, Any] = {"type": [desc.type.json_type, "null"]}
     value: Dict[str, Any] = elem if desc.count == 1 else {"type": "array", "items": elem,
                                           "minItems": desc.count, "maxItems": desc.count}
     integer = {"type": "integer"}

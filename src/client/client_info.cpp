@@ -10,6 +10,7 @@
 #include "client/sized_struct.h"
 #include "common/platform.h"
 #include "common/value_type.h"
+#include "store/freshness.h"
 #include "store/segment.h"
 
 namespace {
@@ -129,8 +130,8 @@ static int FillSignalStats(const ccomm_client* c, ccomm_signal s, ccomm_signal_s
   const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
   const uint64_t now = platform::MonotonicNs();
   out->last_rx_age_ns = last ? Age(now, last) : -1;
-  out->stale = (d.flags & st::kSigConsumedHere) && stale_ns &&
-               (!last || static_cast<uint64_t>(Age(now, last)) > stale_ns);
+  out->stale = (d.flags & st::kSigConsumedHere) &&
+               st::IsStale(last != 0, last ? static_cast<uint64_t>(Age(now, last)) : 0, stale_ns);
   return 0;
 }
 

@@ -176,6 +176,12 @@ cat "$out/4c.out"
 [ "$IT_RC" = 0 ] || { echo "FAIL 4C harness exit status $IT_RC: $(cat "$out/4c.err")"; fail=1; }
 
 echo "== 20-sim 4C component: generator checks"
+export CCOMM_CCOMMD=$bin/ccommd  # the generator reads signals.xml through ccommd --check --json
+bad=$out/bad-signals.xml
+sed 's/type="double"/type="doubel"/' "$cfg" >"$bad"
+if python3 "$here/4c/gen_4c.py" "$bad" ctrl "$out/gb" 2>"$out/e6"; then echo "FAIL bad type accepted"; fail=1;
+elif grep -q "bad-signals.xml:[0-9]*: error" "$out/e6"; then echo "PASS ccommd's error for a bad file: $(head -1 "$out/e6")"
+else echo "FAIL bad file: no FILE:LINE error: $(cat "$out/e6")"; fail=1; fi
 if python3 "$here/4c/gen_4c.py" "$cfg" nosuch "$out/g" 2>"$out/e5"; then echo "FAIL unknown node accepted"; fail=1;
 else echo "PASS unknown node refused: $(cat "$out/e5")"; fi
 if CCOMM_NODE=ctrl CCOMM_GEN_20SIM4C="$here/4c/gen_4c.py" "$bin/ccomm" gen 20sim4c "$cfg" "$out/gcli" >/dev/null &&

@@ -71,15 +71,8 @@ static int32_t signal_type_for(int dtype) {
 }
 
 static const char* signal_type_name(int32_t type) {
-  switch (type) {
-    case CCOMM_BOOL: return "bool";
-    case CCOMM_INT32: return "int32";
-    case CCOMM_UINT32: return "uint32";
-    case CCOMM_INT64: return "int64";
-    case CCOMM_FLOAT: return "float";
-    case CCOMM_DOUBLE: return "double";
-    default: return "?";
-  }
+  const char* name = ccomm_type_name(type);
+  return name ? name : "?";
 }
 
 ccomm_blk* ccomm_blk_open(const char* node, const char* signal, int width, int for_write,

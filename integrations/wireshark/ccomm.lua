@@ -11,8 +11,9 @@
 -- It checks every frame the way the receiver's DecodeHeader() does, in the same order,
 -- and raises one expert info per problem ("bad_entry: entry 0: unknown type 7"); the
 -- first one, which is what ccommd would count, is also the field ccomm.decode_error.
--- With the preference ccomm.config (a signals.xml) it names nodes and signals, checks
--- config_hash against the file's hash (receiver rule 4, config_mismatch) and flags entries
+-- With the preference ccomm.config (the system's configuration as `ccommd --check
+-- signals.xml --json > system.json` writes it) it names nodes and signals, checks
+-- config_hash against the configuration's hash (receiver rule 4, config_mismatch) and flags entries
 -- that do not match the configuration (receiver rule 6, bad_signal).
 -- Documentation: docs/integrations/wireshark.md.
 
@@ -30,7 +31,6 @@ local DEST_ALL = 0xFFFF
 -- Builds with Lua 5.2 have bit32; with 5.3 or later, the operators instead (a syntax
 -- error for 5.2's parser, hence load()).
 local band = bit32 and bit32.band or load("return function(a, b) return a & b end")()
-local bxor = bit32 and bit32.bxor or load("return function(a, b) return a ~ b end")()
 
 -- code -> name, element size (docs/protocol.md "Types")
 local TYPES = {
@@ -136,71 +136,47 @@ ccomm.experts = { E.too_short, E.bad_magic, E.bad_version, E.bad_header, E.bad_e
 
 ccomm.prefs.udp_port = Pref.uint("UDP port", 47800, "UDP port of ccomm frames (<network udp_port=...>)")
 ccomm.prefs.ethertype = Pref.uint("EtherType", 0x88B5, "EtherType of raw ccomm frames (<network ethertype=...>)")
-ccomm.prefs.config = Pref.string("signals.xml", "",
-  "Path of the system's signals.xml: names nodes and signals, checks entries against it")
+ccomm.prefs.config = Pref.string("Configuration (JSON)", "",
+  "Output of ccommd --check signals.xml --json: names nodes and signals, checks entries against it")
 
 local udp_port_field = Field.new("udp.port")
 
 
--- ---- optional configuration (signals.xml) ---------------------------------------------
--- Nodes and signals are numbered by their position in the file (docs/config.md); the
--- hash is SystemConfig::hash (FNV-1a 32 over the canonical form, docs/config.md).
+-- ---- optional configuration ----------------------------------------------------------
+-- The system's configuration as ccommd resolves it: the JSON that
+-- `ccommd --check signals.xml --json` prints (ccommd's parser is the one reader of
+-- signals.xml; its hash is what frames carry as config_hash). Nodes and signals come with
+-- their ids. Only that output is read, so a few patterns do (names are identifiers, and
+-- signal objects hold no nested object).
 local config = { path = "", nodes = {}, node_ids = {}, signals = {}, hash = nil, error = nil }
-
-local function xml_attr(tag, name)
-  local v = tag:match("%s" .. name .. "%s*=%s*\"([^\"]*)\"") or tag:match("%s" .. name .. "%s*=%s*'([^']*)'")
-  return v and v:gsub("^%s+", ""):gsub("%s+$", "") or nil
-end
-
-local function fnv1a32(text)
-  local h = 2166136261
-  for i = 1, #text do
-    h = bxor(h, text:byte(i))
-    -- h * 16777619 mod 2^32 without losing bits in a double: 16777619 = 2^24 + 403
-    h = ((h % 256) * 16777216 + h * 403) % 4294967296
-  end
-  return h
-end
 
 local function load_config(path)
   config = { path = path, nodes = {}, node_ids = {}, signals = {}, hash = nil, error = nil }
   if path == "" then return end
   local fh, err = io.open(path, "r")
-  if not fh then config.error = "cannot read signals.xml: " .. tostring(err); return end
-  local text = fh:read("*a"):gsub("<!%-%-.-%-%->", "")  -- comments may hold example tags
+  if not fh then config.error = "cannot read the configuration: " .. tostring(err); return end
+  local text = fh:read("*a")
   fh:close()
-  local ethertype, udp_port, nn, ns = 34997, 47800, 0, 0
-  local canon_signals = {}
-  for kind, tag in text:gmatch("<(%a+)(%s[^>]*)>") do
-    if kind == "network" then
-      ethertype = tonumber(xml_attr(tag, "ethertype") or "") or ethertype
-      udp_port = tonumber(xml_attr(tag, "udp_port") or "") or udp_port
-    elseif kind == "node" then
-      local name = xml_attr(tag, "name") or "?"
-      config.nodes[nn], config.node_ids[name] = name, nn
-      nn = nn + 1
-    elseif kind == "signal" then
-      local sig = { name = xml_attr(tag, "name") or "?", type_name = xml_attr(tag, "type") or "?",
-                    count = tonumber(xml_attr(tag, "count") or "1") or 1,
-                    kind = xml_attr(tag, "kind") or "state", producer = xml_attr(tag, "producer") or "?",
-                    consumers = xml_attr(tag, "consumers") or "" }
-      for code, t in pairs(TYPES) do if t.name == sig.type_name then sig.type = code end end
-      config.signals[ns], canon_signals[#canon_signals + 1] = sig, sig
-      ns = ns + 1
-    end
+  local hash = text:match('"hash":"(%x+)"')
+  local nodes = text:match('"nodes":%[(.-)%]')
+  local signals = text:match('"signals":%[(.*)%],"ros2"')
+  if not (text:match('^{"format":1,') and hash and nodes and signals) then
+    config.error = path .. " is not the output of ccommd --check signals.xml --json"
+    return
   end
-  local lines = { "ccomm-config 1", string.format("network %d %d", ethertype, udp_port) }
-  for i = 0, nn - 1 do lines[#lines + 1] = "node " .. config.nodes[i] end
-  for _, sig in ipairs(canon_signals) do
-    local ids = {}
-    for name in sig.consumers:gmatch("[^,%s]+") do ids[#ids + 1] = config.node_ids[name] or -1 end
-    table.sort(ids)
-    local names = {}
-    for _, id in ipairs(ids) do names[#names + 1] = config.nodes[id] or "?" end
-    lines[#lines + 1] = string.format("signal %s %s %d %s %s %s", sig.name, sig.type_name, sig.count,
-                                      sig.kind, sig.producer, #names > 0 and table.concat(names, ",") or "-")
+  for obj in nodes:gmatch("{(.-)}") do
+    local id, name = tonumber(obj:match('"id":(%d+)')), obj:match('"name":"([^"]*)"')
+    if id and name then config.nodes[id], config.node_ids[name] = name, id end
   end
-  config.hash = fnv1a32(table.concat(lines, "\n") .. "\n")
+  for obj in signals:gmatch("{(.-)}") do
+    local id = tonumber(obj:match('"id":(%d+)'))
+    local sig = { name = obj:match('"name":"([^"]*)"') or "?", type_name = obj:match('"type":"([^"]*)"') or "?",
+                  count = tonumber(obj:match('"count":(%d+)') or "1") or 1,
+                  kind = obj:match('"kind":"(%a+)"') or "state", producer = obj:match('"producer":"([^"]*)"') or "?" }
+    for code, t in pairs(TYPES) do if t.name == sig.type_name then sig.type = code end end
+    if id then config.signals[id] = sig end
+  end
+  config.hash = tonumber(hash, 16)
 end
 
 -- ---- value formatting ------------------------------------------------------------------

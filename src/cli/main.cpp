@@ -248,6 +248,16 @@ int CmdGen(const char* node, int argc, char** argv) {
   // The generator is a Python script installed with the integrations.
   const char* gen = getenv("CCOMM_GEN_20SIM4C");
   std::string path = gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py";
+  // It reads signals.xml through `ccommd --check --json`: in a build tree the ccommd beside
+  // this program, installed the one in sbin (the generator looks there).
+  char self[4096];
+  const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (!getenv("CCOMM_CCOMMD") && len > 0) {
+    self[len] = '\0';
+    std::string beside(self);
+    beside = beside.substr(0, beside.rfind('/') + 1) + "ccommd";
+    if (access(beside.c_str(), X_OK) == 0) setenv("CCOMM_CCOMMD", beside.c_str(), 1);
+  }
   std::vector<char*> args;
   std::string py = "python3";
   args.push_back(&py[0]);

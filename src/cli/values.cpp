@@ -16,24 +16,11 @@ namespace ccomm {
 namespace cli {
 
 const char* TypeName(int type) {
-  switch (type) {
-    case CCOMM_BOOL: return "bool";
-    case CCOMM_INT32: return "int32";
-    case CCOMM_UINT32: return "uint32";
-    case CCOMM_INT64: return "int64";
-    case CCOMM_FLOAT: return "float";
-    case CCOMM_DOUBLE: return "double";
-    default: return "?";
-  }
+  const char* name = ccomm_type_name(type);
+  return name ? name : "?";
 }
 
-static size_t ElemSize(int type) {
-  switch (type) {
-    case CCOMM_BOOL: return 1;
-    case CCOMM_INT64: case CCOMM_DOUBLE: return 8;
-    default: return 4;
-  }
-}
+static size_t ElemSize(int type) { return ccomm_type_size(type); }
 
 static std::string FormatOne(int type, const uint8_t* p) {
   char buf[64];

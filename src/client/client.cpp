@@ -13,6 +13,7 @@
 #include "client/doorbell.h"
 #include "common/platform.h"
 #include "common/value_type.h"
+#include "store/freshness.h"
 #include "store/segment.h"
 
 using ccomm::store::RingCursor;
@@ -136,7 +137,7 @@ __attribute__((always_inline)) inline int FinishState(HandleSignal* h, void* val
     status = CCOMM_NEVER;
   } else {
     age = Age(now, meta.local_time_ns);
-    status = (h->stale_ns && static_cast<uint64_t>(age) > h->stale_ns) ? CCOMM_STALE : CCOMM_FRESH;
+    status = st::IsStale(true, static_cast<uint64_t>(age), h->stale_ns) ? CCOMM_STALE : CCOMM_FRESH;
   }
   uint32_t flags = 0;
   if (status != CCOMM_FRESH && h->safe_value) {
@@ -193,7 +194,7 @@ __attribute__((always_inline)) inline int ReadState8(ccomm_client* c, HandleSign
   memcpy(value, k.value, 8);
   const uint64_t now = Now(c);
   const int64_t age = Age(now, k.meta.local_time_ns);
-  if (__builtin_expect(h->stale_ns != 0 && static_cast<uint64_t>(age) > h->stale_ns, 0))
+  if (__builtin_expect(st::IsStale(true, static_cast<uint64_t>(age), h->stale_ns), 0))
     return FinishStateSlow(h, value, info, StoreResult::kOk, now);
   if (info) {
     info->status = CCOMM_FRESH;

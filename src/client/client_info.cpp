@@ -3,17 +3,31 @@
 // and the daemon's state. None is on a control loop's path; all read the segment through
 // the handle's public view of it (client_internal.h), like history.cpp.
 #include <stdint.h>
+#include <string.h>
 
 #include "ccomm/ccomm.h"
 #include "client/client_internal.h"
+#include "client/sized_struct.h"
 #include "common/platform.h"
+#include "common/value_type.h"
+#include "store/freshness.h"
 #include "store/segment.h"
 
 namespace {
 
 namespace st = ccomm::store;
 namespace platform = ccomm::platform;
+using ccomm::client::CopySized;
 using ccomm::client::SegmentOf;
+
+// ccomm_signal_stats as ccomm 0.1.0 laid it out: what the plain ccomm_get_signal_stats
+// symbol fills for programs built against that header.
+struct SignalStats010 {
+  uint64_t writes, write_errors, tx, coalesced, rx, lost, overflow, stale_transitions;
+  int64_t last_rx_age_ns;
+  int32_t stale;
+};
+static_assert(sizeof(SignalStats010) == 80, "the ccomm 0.1.0 layout");
 
 bool ValidSignal(const ccomm_client* c, ccomm_signal s) {
   return c && s >= 0 && static_cast<uint32_t>(s) < SegmentOf(c).signal_count();
@@ -46,8 +60,8 @@ const char* ccomm_strerror(int code) {
   }
 }
 
-int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
-  if (!ValidSignal(c, s) || !out) return CCOMM_E_INVAL;
+static int FillDescription(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
+  if (!ValidSignal(c, s)) return CCOMM_E_INVAL;
   const st::Segment& seg = SegmentOf(c);
   const st::SignalDirectoryEntry& d = seg.dir(static_cast<uint32_t>(s));
   out->name = d.name;
@@ -62,6 +76,32 @@ int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out
   return 0;
 }
 
+int ccomm_describe_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out, size_t size) {
+  ccomm_signal_desc d{};
+  return CopySized(FillDescription(c, s, &d), d, out, size);
+}
+
+// The plain symbols (parenthesised: ccomm.h makes the names macros of the *_sized calls).
+int(ccomm_describe)(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
+  return ccomm_describe_sized(c, s, out, sizeof(ccomm_signal_desc));
+}
+
+const char* ccomm_type_name(int32_t type) {
+  return type > 0 && ccomm::ValueTypeSize(static_cast<uint8_t>(type)) ? ccomm::ValueTypeName(static_cast<ccomm::ValueType>(type))
+                                                                      : nullptr;
+}
+
+uint32_t ccomm_type_size(int32_t type) {
+  return type > 0 && type < 256 ? static_cast<uint32_t>(ccomm::ValueTypeSize(static_cast<uint8_t>(type))) : 0;
+}
+
+int ccomm_type_from_name(const char* name) {
+  if (!name) return CCOMM_E_INVAL;
+  for (ccomm::ValueType t : ccomm::kAllValueTypes)
+    if (strcmp(ccomm::ValueTypeName(t), name) == 0) return static_cast<int>(t);
+  return CCOMM_E_INVAL;
+}
+
 int ccomm_daemon_alive(const ccomm_client* c) {
   if (!c) return 0;
   const st::SegmentHeader* h = SegmentOf(c).header();
@@ -70,8 +110,8 @@ int ccomm_daemon_alive(const ccomm_client* c) {
   return platform::MonotonicNs() - hb < 1000000000ull ? 1 : 0;
 }
 
-int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out) {
-  if (!ValidSignal(c, s) || !out) return CCOMM_E_INVAL;
+static int FillSignalStats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out) {
+  if (!ValidSignal(c, s)) return CCOMM_E_INVAL;
   const st::Segment& seg = SegmentOf(c);
   const st::SignalDirectoryEntry& d = seg.dir(static_cast<uint32_t>(s));
   const st::SignalStats& ss = seg.stats(static_cast<uint32_t>(s));
@@ -90,15 +130,31 @@ int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_s
   const uint64_t last = ss.last_rx_ns.load(std::memory_order_relaxed);
   const uint64_t now = platform::MonotonicNs();
   out->last_rx_age_ns = last ? Age(now, last) : -1;
-  out->stale = (d.flags & st::kSigConsumedHere) && stale_ns &&
-               (!last || static_cast<uint64_t>(Age(now, last)) > stale_ns);
+  out->stale = (d.flags & st::kSigConsumedHere) &&
+               st::IsStale(last != 0, last ? static_cast<uint64_t>(Age(now, last)) : 0, stale_ns);
   return 0;
 }
 
 int ccomm_node_count(const ccomm_client* c) { return c ? static_cast<int>(SegmentOf(c).node_count()) : CCOMM_E_INVAL; }
 
-int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out) {
-  if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= SegmentOf(c).node_count()) return CCOMM_E_INVAL;
+int ccomm_get_signal_stats_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out, size_t size) {
+  ccomm_signal_stats st{};
+  return CopySized(FillSignalStats(c, s, &st), st, out, size);
+}
+
+int(ccomm_get_signal_stats)(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out) {
+  if (!out) return CCOMM_E_INVAL;
+  ccomm_signal_stats st{};
+  const int rc = FillSignalStats(c, s, &st);
+  if (rc != 0) return rc;
+  SignalStats010 old{st.writes, st.write_errors, st.tx,   st.coalesced,         st.rx,
+                     st.lost,   st.overflow,     st.stale_transitions, st.last_rx_age_ns, st.stale};
+  memcpy(static_cast<void*>(out), &old, sizeof old);
+  return 0;
+}
+
+static int FillPeerStats(const ccomm_client* c, int node, ccomm_peer_stats* out) {
+  if (!c || node < 0 || static_cast<uint32_t>(node) >= SegmentOf(c).node_count()) return CCOMM_E_INVAL;
   const st::Segment& seg = SegmentOf(c);
   const uint32_t n = static_cast<uint32_t>(node);
   const st::PeerStats& ps = seg.peer(n);
@@ -114,6 +170,15 @@ int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out)
   const uint64_t last = ps.last_rx_ns.load(std::memory_order_relaxed);
   out->last_rx_age_ns = last ? Age(platform::MonotonicNs(), last) : -1;
   return 0;
+}
+
+int ccomm_get_peer_stats_sized(const ccomm_client* c, int node, ccomm_peer_stats* out, size_t size) {
+  ccomm_peer_stats ps{};
+  return CopySized(FillPeerStats(c, node, &ps), ps, out, size);
+}
+
+int(ccomm_get_peer_stats)(const ccomm_client* c, int node, ccomm_peer_stats* out) {
+  return ccomm_get_peer_stats_sized(c, node, out, sizeof(ccomm_peer_stats));
 }
 
 int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {

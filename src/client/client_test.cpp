@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <array>
 #include <atomic>
@@ -201,8 +202,68 @@ TEST_F(ClientTest, TwoAppsOnOneNodeThroughSharedMemory) {
   EXPECT_EQ(ga.value[1], -2);
   // Wrong type / count is refused at lookup.
   EXPECT_FALSE(reader.signal<double>("local").valid());
-  EXPECT_EQ(reader.last_error(), CCOMM_E_TYPE);
+  EXPECT_EQ(reader.error(), CCOMM_E_TYPE);
   EXPECT_FALSE((reader.signal<std::array<int32_t, 2>>("arr").valid()));
+}
+
+TEST_F(ClientTest, CppCoversBatchStatsAndIntrospection) {
+  ccomm::Client batch("a", CCOMM_OPEN_BATCH), reader("a");
+  ASSERT_TRUE(batch.ok());
+  auto w = batch.signal<float>("local");
+  auto r = reader.signal<float>("local");
+  ASSERT_EQ(w.write(1.5f), 0);
+  EXPECT_TRUE(r.read().never());  // held in the batch handle until the flush
+  ASSERT_EQ(batch.flush(), 0);
+  EXPECT_EQ(r.read().value, 1.5f);
+  ccomm_signal_stats st;
+  ASSERT_EQ(w.stats(st), 0);
+  EXPECT_EQ(st.writes, 1u);
+  EXPECT_EQ(batch.signal_count(), 5);
+  ccomm_signal_desc d;
+  ASSERT_EQ(batch.describe(w.id(), d), 0);
+  EXPECT_STREQ(d.name, "local");
+  EXPECT_EQ(batch.node_count(), 2);
+  ccomm_peer_stats ps;
+  ASSERT_EQ(batch.peer_stats(0, ps), 0);
+  EXPECT_EQ(ps.is_self, 1);
+  EXPECT_EQ(batch.peer_stats(5, ps), CCOMM_E_INVAL);
+}
+
+TEST_F(ClientTest, SizedCallsServeOlderAndNewerCallers) {
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  const ccomm_signal s = ccomm_find(c, "local");
+  ASSERT_EQ(ccomm_write_float(c, s, 2.0f), 0);
+  // A newer program's bigger struct: this library's fields, zeros beyond.
+  unsigned char big[sizeof(ccomm_signal_stats) + 16];
+  memset(big, 0xff, sizeof big);
+  ASSERT_EQ(ccomm_get_signal_stats_sized(c, s, reinterpret_cast<ccomm_signal_stats*>(big), sizeof big), 0);
+  for (size_t i = sizeof(ccomm_signal_stats); i < sizeof big; ++i) EXPECT_EQ(big[i], 0) << i;
+  ccomm_signal_stats now;
+  memcpy(&now, big, sizeof now);
+  EXPECT_EQ(now.writes, 1u);
+  // Smaller than the struct these calls began with: refused, untouched.
+  unsigned char small[88];
+  memset(small, 0xff, sizeof small);
+  EXPECT_EQ(ccomm_get_signal_stats_sized(c, s, reinterpret_cast<ccomm_signal_stats*>(small), sizeof small),
+            CCOMM_E_INVAL);
+  EXPECT_EQ(small[0], 0xff);
+  // The plain symbol, as a program built against ccomm 0.1.0 calls it: that layout, 80
+  // bytes (writes at 0, last_rx_age_ns at 64, stale at 72), nothing beyond.
+  unsigned char old[96];
+  memset(old, 0xff, sizeof old);
+  ASSERT_EQ((ccomm_get_signal_stats)(c, s, reinterpret_cast<ccomm_signal_stats*>(old)), 0);
+  uint64_t writes;
+  int64_t age;
+  int32_t stale;
+  memcpy(&writes, old, 8);
+  memcpy(&age, old + 64, 8);
+  memcpy(&stale, old + 72, 4);
+  EXPECT_EQ(writes, 1u);
+  EXPECT_EQ(age, -1);
+  EXPECT_EQ(stale, 0);
+  for (size_t i = 80; i < sizeof old; ++i) EXPECT_EQ(old[i], 0xff) << i;
+  ccomm_close(c);
 }
 
 TEST_F(ClientTest, EventsArriveOncePerReader) {
@@ -330,7 +391,7 @@ TEST_F(ClientTest, RetiredSegmentIsReported) {
   ccomm::Client c("a");
   auto s = c.signal<float>("local");
   seg_a_.header()->state.store(store::kRetired);
-  EXPECT_EQ(s.read().code, CCOMM_E_RETIRED);
+  EXPECT_EQ(s.read().status, CCOMM_E_RETIRED);
   EXPECT_EQ(s.write(1.0f), CCOMM_E_RETIRED);
 }
 

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <array>
 #include <atomic>
 #include <thread>
 
 #include "ccomm/ccomm.h"
+#include "ccomm/ccomm.hpp"
 #include "common/platform.h"
 #include "daemon/segment_builder.h"
 #include "store/segment.h"
@@ -152,6 +154,31 @@ TEST_F(HistoryTest, ConcurrentAppendAndReadLoseNothingUncounted) {
   EXPECT_TRUE(intact);
   EXPECT_EQ(last, kValues);
   EXPECT_EQ(got + cur.overrun, kValues);
+}
+
+TEST_F(HistoryTest, CppHistoryReadsWhatTheCApiReads) {
+  ccomm::Client client("a");
+  ASSERT_TRUE(client.ok());
+  auto sp = client.signal<std::array<double, 2>>("sp");
+  ASSERT_TRUE(sp.valid());
+  auto none = client.signal<double>("pos").history();
+  EXPECT_EQ(none.status(), CCOMM_E_NOENT);  // produced here: no history
+  EXPECT_EQ(none.read().status, CCOMM_E_NOENT);
+  auto h = sp.history(0);
+  ASSERT_EQ(h.status(), 0);
+  EXPECT_EQ(h.depth(), static_cast<int>(kDepth));
+  EXPECT_TRUE(h.read().empty());
+  for (uint64_t s = 1; s <= kDepth + 3; ++s) Append(s);
+  uint64_t first = 0, n = 0;
+  for (auto r = h.read(); !r.empty(); r = h.read()) {
+    ASSERT_FALSE(r.error());
+    if (!first) first = r.info.seq;
+    EXPECT_EQ(r.value[1], -static_cast<double>(r.info.seq));
+    ++n;
+  }
+  EXPECT_EQ(n, kDepth);
+  EXPECT_EQ(first, 4u);
+  EXPECT_EQ(h.overrun(), 3u);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <new>
 
 #include "ccomm/ccomm.h"
+#include "client/sized_struct.h"
 #include "store/view.h"
 
 struct ccomm_view {
@@ -71,8 +72,8 @@ int ccomm_view_open(const ccomm_client* c, ccomm_view** out) {
 
 void ccomm_view_close(ccomm_view* v) { delete v; }
 
-int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out) {
-  if (!v || !out || node < 0 || node >= static_cast<int>(v->view.header()->node_count)) return CCOMM_E_INVAL;
+static int FillViewNode(const ccomm_view* v, int node, ccomm_view_node* out) {
+  if (!v || node < 0 || node >= static_cast<int>(v->view.header()->node_count)) return CCOMM_E_INVAL;
   st::ViewNodeCopy n;
   if (!ReadPatiently([&] { return v->view.ReadNode(static_cast<uint32_t>(node), &n); })) return CCOMM_E_BUSY;
   const int64_t now = ccomm_now();
@@ -96,8 +97,18 @@ int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out) {
   return 0;
 }
 
-int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out) {
-  if (!v || !out || node < 0 || node >= static_cast<int>(v->view.header()->node_count) || s < 0 ||
+int ccomm_view_get_node_sized(const ccomm_view* v, int node, ccomm_view_node* out, size_t size) {
+  ccomm_view_node n{};
+  return ccomm::client::CopySized(FillViewNode(v, node, &n), n, out, size);
+}
+
+// The plain symbols (parenthesised: ccomm.h makes the names macros of the *_sized calls).
+int(ccomm_view_get_node)(const ccomm_view* v, int node, ccomm_view_node* out) {
+  return ccomm_view_get_node_sized(v, node, out, sizeof(ccomm_view_node));
+}
+
+static int FillViewSignal(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out) {
+  if (!v || node < 0 || node >= static_cast<int>(v->view.header()->node_count) || s < 0 ||
       s >= static_cast<int>(v->view.header()->signal_count))
     return CCOMM_E_INVAL;
   st::ViewRowCopy r;
@@ -121,8 +132,18 @@ int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_v
   return 0;
 }
 
-int ccomm_view_get_counters(const ccomm_view* v, ccomm_view_counters* out) {
-  if (!v || !out) return CCOMM_E_INVAL;
+int ccomm_view_get_signal_sized(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out,
+                                size_t size) {
+  ccomm_view_signal vs{};
+  return ccomm::client::CopySized(FillViewSignal(v, node, s, &vs), vs, out, size);
+}
+
+int(ccomm_view_get_signal)(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out) {
+  return ccomm_view_get_signal_sized(v, node, s, out, sizeof(ccomm_view_signal));
+}
+
+static int FillViewCounters(const ccomm_view* v, ccomm_view_counters* out) {
+  if (!v) return CCOMM_E_INVAL;
   const st::ViewHeader* h = v->view.header();
   out->summaries_tx = h->summaries_tx.load(std::memory_order_relaxed);
   out->summaries_rx = h->summaries_rx.load(std::memory_order_relaxed);
@@ -131,6 +152,15 @@ int ccomm_view_get_counters(const ccomm_view* v, ccomm_view_counters* out) {
   out->summaries_send_errors = h->summaries_send_errors.load(std::memory_order_relaxed);
   out->summary_ms = h->summary_ms;
   return 0;
+}
+
+int ccomm_view_get_counters_sized(const ccomm_view* v, ccomm_view_counters* out, size_t size) {
+  ccomm_view_counters vc{};
+  return ccomm::client::CopySized(FillViewCounters(v, &vc), vc, out, size);
+}
+
+int(ccomm_view_get_counters)(const ccomm_view* v, ccomm_view_counters* out) {
+  return ccomm_view_get_counters_sized(v, out, sizeof(ccomm_view_counters));
 }
 
 }  // extern "C"

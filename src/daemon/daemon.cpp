@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common/platform.h"
+#include "store/freshness.h"
 #include "store/reclaim.h"
 
 namespace ccomm {
@@ -222,7 +223,7 @@ void Daemon::Supervise(uint64_t now) {
     const SignalConfig& s = cfg_->signals[id];
     if (!s.stale_after_ms) continue;
     uint64_t last = segment_.stats(id).last_rx_ns.load(std::memory_order_relaxed);
-    bool fresh = last && (last >= now || now - last <= uint64_t{s.stale_after_ms} * 1000000);
+    bool fresh = !store::IsStale(last != 0, last < now ? now - last : 0, uint64_t{s.stale_after_ms} * 1000000);
     if (fresh_[id] && !fresh) segment_.stats(id).stale_transitions.fetch_add(1, std::memory_order_relaxed);
     fresh_[id] = fresh;
   }

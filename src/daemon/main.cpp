@@ -14,6 +14,7 @@
 
 #include "common/platform.h"
 #include "config/config.h"
+#include "config/config_json.h"
 #include "daemon/daemon.h"
 #include "daemon/node_identity.h"
 #include "daemon/privileges.h"
@@ -39,6 +40,8 @@ const char kUsage[] =
     "                        on one of this board's interfaces: one image for every board)\n"
     "      --which-node      print which node this board is, and how it was found; exit\n"
     "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
+    "      --json            with --check: print the resolved configuration as JSON (nodes,\n"
+    "                        signals, types, hash, ros2) for tools; docs/config.md\n"
     "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
     "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
     "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
@@ -76,7 +79,8 @@ int main(int argc, char** argv) {
       {"no-rt", no_argument, nullptr, 'R'},        {"verbose", no_argument, nullptr, 'v'},
       {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
       {"version", no_argument, nullptr, 'V'},      {"which-node", no_argument, nullptr, 'W'},
-      {nullptr, 0, nullptr, 0}};
+      {"json", no_argument, nullptr, 'J'},         {nullptr, 0, nullptr, 0}};
+  bool json = false;
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
     switch (ch) {
@@ -96,6 +100,7 @@ int main(int argc, char** argv) {
         break;
       case 'R': opt.no_realtime = true; break;
       case 'W': opt.which_node = true; break;
+      case 'J': json = true; break;
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
       case 'q': verbosity = 4; break;
       case 'h': fputs(kUsage, stdout); return 0;
@@ -103,6 +108,10 @@ int main(int argc, char** argv) {
                        store::kLayoutVersion); return 0;
       default: fputs(kUsage, stderr); return 2;
     }
+  }
+  if (json && !opt.check_only) {
+    fprintf(stderr, "ccommd: --json goes with --check\n");
+    return 2;
   }
   if (optind < argc) {
     fprintf(stderr, "ccommd: unexpected argument '%s'\n%s", argv[optind], kUsage);
@@ -117,6 +126,10 @@ int main(int argc, char** argv) {
     fprintf(stderr, "%s", error.c_str());
     if (!error.empty() && error.back() != '\n') fputc('\n', stderr);
     return 1;
+  }
+  if (opt.check_only && json) {
+    fputs(ConfigToJson(cfg).c_str(), stdout);
+    return 0;
   }
   if (opt.check_only) {
     // A valid file can still need more shared memory than this machine gives (queue_depth

@@ -8,6 +8,7 @@
 
 #include "common/platform.h"
 #include "daemon/daemon.h"
+#include "store/freshness.h"
 
 namespace ccomm {
 namespace {
@@ -175,7 +176,7 @@ uint32_t SystemView::Tick(uint64_t now) {
       rec.lost = st.lost.load(std::memory_order_relaxed);
       rec.age_ms = AgeMs(st.last_rx_ns.load(std::memory_order_relaxed), now);
       const uint32_t stale_ms = cfg_->signals[rep.id].stale_after_ms;
-      if (stale_ms && (rec.age_ms == wire::kSummaryNoAge || rec.age_ms > stale_ms)) rec.flags |= wire::kRecordStale;
+      if (store::IsStale(rec.age_ms != wire::kSummaryNoAge, rec.age_ms, stale_ms)) rec.flags |= wire::kRecordStale;
     }
     if (rec.age_ms == wire::kSummaryNoAge) rec.flags |= wire::kRecordNever;
   }

@@ -58,7 +58,6 @@ bool ResolveRoutes(Bridge* b, ccomm_client* c, const std::vector<Route*>& routes
 
 namespace {
 
-const char* kTypeNames[] = {"?", "bool", "int32", "uint32", "int64", "float", "double"};
 
 bool AddRoute(Bridge* b, ccomm_client* c, const std::string& name, bool to_ros) {
   ccomm_signal id = ccomm_find(c, name.c_str());
@@ -126,7 +125,7 @@ void PrintRoutes(const Bridge* b) {
         snprintf(qos, sizeof qos, "best_effort, keep_last 16, volatile");
       printf("%-4s %-28s %-32s %-8s %s  [%s x%u] %s\n", r->to_ros ? "->" : "<-", r->topic.c_str(),
              r->type->ros_name, r->desc.is_event ? "event" : "state", qos,
-             kTypeNames[r->desc.type >= 1 && r->desc.type <= 6 ? r->desc.type : 0], r->desc.count,
+             ccomm_type_name(r->desc.type) ? ccomm_type_name(r->desc.type) : "?", r->desc.count,
              r->type->type_hash);
     }
 }

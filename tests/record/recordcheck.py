@@ -249,13 +249,15 @@ def small_recording(path: str) -> None:
     """A valid recording made by ccomm-record's own writer from made-up captured records:
     a double, a double[4] with NaN and infinities, an int32 and a bool event signal."""
     import struct
-    from ccomm.mcap_io.capi import SignalDesc
+    from ccomm import SignalInfo, SignalType
     from ccomm.mcap_io.schema import RECORD
     from ccomm.mcap_io.writer import RecordingWriter, WriterOptions
-    sigs = [SignalDesc(0, "speed", "double", 1, 8, False, True, False, "a", 0),
-            SignalDesc(1, "pose", "double", 4, 32, False, True, False, "a", 0),
-            SignalDesc(2, "mode", "int32", 1, 4, False, True, False, "a", 0),
-            SignalDesc(3, "estop", "bool", 1, 1, True, True, False, "a", 0)]
+
+    def desc(sid: int, name: str, t: SignalType, count: int, size: int, event: bool) -> SignalInfo:
+        return SignalInfo(id=sid, name=name, type=t, count=count, value_bytes=size, is_event=event,
+                          produced_here=True, stale_after_ms=0, producer="a")
+    sigs = [desc(0, "speed", SignalType.DOUBLE, 1, 8, False), desc(1, "pose", SignalType.DOUBLE, 4, 32, False),
+            desc(2, "mode", SignalType.INT32, 1, 4, False), desc(3, "estop", SignalType.BOOL, 1, 1, True)]
     w = RecordingWriter(WriterOptions(output=path, signals=sigs, node="a", chunk_size=2048))
     w._open()
     buf = bytearray()

@@ -9,7 +9,13 @@
 - their static libraries use no symbol that config, daemon or client define;
 - libccomm.so (the client library every application loads) carries no XML parser:
   no RapidXML, no configuration parser, no config library symbol, exports nothing but
-  the C API (ccomm_*), and needs no library beyond the C/C++ runtime.
+  the C API (ccomm_*), and needs no library beyond the C/C++ runtime;
+- the applications of the public API (the CLI, tools, the ROS 2 bridge) include nothing
+  of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp only;
+- signals.xml has one parser (src/config/): no other code uses an XML parser on it
+  (tools read `ccommd --check FILE --json`), and the value types' names are tabled once
+  (src/common/value_type.h; ccomm_type_name() gives them out).
+Each exception is listed below with its reason.
 Exit 0 if all hold; 1 with one line per violation.
 """
 import os
@@ -19,6 +25,24 @@ import sys
 
 BOTTOM = {"store": {"store", "common"}, "wire": {"wire", "common"}}
 UPPER = ("config", "daemon", "client")
+APPLICATIONS = ("cli", "tools", "ros2")
+INTERNALS = {"config", "daemon", "store", "wire", "client", "common"}
+# (file, include): why it is allowed for now.
+APPLICATION_INCLUDES = {
+    ("src/ros2/config_section.cpp", "config/config.h"):
+        "the <ros2> section is still parsed by the core parser (issue 26: move it into src/ros2)",
+}
+CODE = (".py", ".lua", ".c", ".cc", ".cpp", ".h", ".hpp", ".js", ".ts")
+XML_PARSERS = re.compile(r"ElementTree|xml\.dom|\blxml\b|rapidxml|\bexpat\b|xml_attr\(")
+TYPE_NAMES = ("bool", "int32", "uint32", "int64", "float", "double")
+# Files that spell out every type name, and why that is no second table.
+TYPE_NAME_TABLES = {
+    "src/common/value_type.h": "the table",
+    "integrations/wireshark/ccomm.lua": "decodes the wire's type codes inside Wireshark, without libccomm "
+                                        "(docs/protocol.md \"Types\")",
+    "scripts/wire_vectors.py": "writes the protocol's test vectors from docs/protocol.md, independently of "
+                               "the C++ encoder",
+}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -48,9 +72,54 @@ def library(build, module, name):
     return path
 
 
+def tracked_code(src):
+    """Source files of the tree (git's list when it is a checkout), relative to `src`."""
+    r = subprocess.run(["git", "-C", src, "ls-files"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    if r.returncode == 0 and r.stdout:
+        names = r.stdout.split("\n")
+    else:
+        names = [os.path.relpath(os.path.join(d, f), src) for d, _, fs in os.walk(src) for f in fs
+                 if "/build" not in d and "/." not in d]
+    return sorted(n for n in names if n.endswith(CODE) and os.path.isfile(os.path.join(src, n)))
+
+
+def one_parser_one_table(src, errors):
+    """No XML parser on signals.xml outside src/config/; the type names tabled once
+    (tests excepted: they may spell names out to check them)."""
+    for name in tracked_code(src):
+        text = open(os.path.join(src, name), encoding="utf-8", errors="replace").read()
+        if name == "tests/structure/check_layering.py":
+            continue  # names the parsers it looks for
+        if not name.startswith("src/config/") and XML_PARSERS.search(text) and \
+                re.search(r"signals\.xml|<signal\b", text):
+            errors.append("%s parses signals.xml with an XML parser (read `ccommd --check FILE --json`: "
+                          "src/config/ is its one parser)" % name)
+        if name.startswith("tests/") or "_test." in name or name in TYPE_NAME_TABLES:
+            continue
+        if all(re.search(r"[\"']%s[\"']" % t, text) for t in TYPE_NAMES):
+            errors.append("%s tables the type names again (use ccomm_type_name(), or "
+                          "SignalType.type_name in Python)" % name)
+
+
+def application_includes(src, errors):
+    for app in APPLICATIONS:
+        adir = os.path.join(src, "src", app)
+        for fname in sorted(os.listdir(adir)):
+            if not fname.endswith((".h", ".cpp", ".c")):
+                continue
+            rel = "src/%s/%s" % (app, fname)
+            text = open(os.path.join(adir, fname), encoding="utf-8").read()
+            for inc in INCLUDE.findall(text):
+                if inc.split("/")[0] in INTERNALS and "/" in inc and (rel, inc) not in APPLICATION_INCLUDES:
+                    errors.append('%s includes "%s": applications use the public API (ccomm/ccomm.h) only'
+                                  % (rel, inc))
+
+
 def main():
     src, build = sys.argv[1], sys.argv[2]
     errors = []
+    application_includes(src, errors)
+    one_parser_one_table(src, errors)
     # 1. Includes of the bottom modules.
     for module, allowed in BOTTOM.items():
         mdir = os.path.join(src, "src", module)
@@ -102,7 +171,8 @@ def main():
     for e in errors:
         print("layering: " + e)
     if not errors:
-        print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser")
+        print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
+              "applications use the public API; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""The dissector's signals.xml support against ccommd: for each configuration in dist/ and
-examples/, a frame carrying the hash `ccommd --check` prints must show no config_mismatch
-with that file loaded, and a frame carrying another hash must show one.
+"""The dissector's configuration support against ccommd: for each configuration in dist/
+and examples/, a frame carrying the hash `ccommd --check` prints must show no
+config_mismatch with that file loaded (as `ccommd --check FILE --json` resolves it), and a
+frame carrying another hash must show one.
 
   confighash.py WORKDIR BIN_DIR
 
@@ -44,7 +45,7 @@ def main():
         h = int(m.group(1), 16)
         pcap = os.path.join(work, "hash.pcap")
         wslib.write_pcap(pcap, [wslib.udp(heartbeat(h)), wslib.udp(heartbeat(h ^ 1))])
-        pkts, _ = ts.fields(pcap, ["_ws.expert.message"], ["-o", "ccomm.config:" + ts.readable(path)])
+        pkts, _ = ts.fields(pcap, ["_ws.expert.message"], ["-o", ts.config(path)])
         msgs = [p.get("_ws.expert.message", []) for p in pkts]
         ok = len(msgs) == 2 and not msgs[0] and any(m.startswith("config_mismatch") for m in msgs[1])
         name = os.path.relpath(path, wslib.ROOT)

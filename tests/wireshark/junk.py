@@ -80,9 +80,9 @@ def main():
         to_ccomm += min(len(fr), cut) >= 8 if heuristic else len(fr) > 0
     pcap = os.path.join(args.workdir, "junk.pcap")
     wslib.write_pcap(pcap, packets, snaplens)
-    config = ts.readable(os.path.join(wslib.ROOT, "dist", "signals.xml"))
+    config = ts.config(os.path.join(wslib.ROOT, "dist", "signals.xml"))
     failed = 0
-    for label, extra in (("no configuration", []), ("with dist/signals.xml", ["-o", "ccomm.config:" + config])):
+    for label, extra in (("no configuration", []), ("with dist/signals.xml", ["-o", config])):
         r = ts.run(["-n", "-r", ts.readable(pcap), "-V"] + extra, check=False, timeout=600)
         roots = sum(1 for line in r.stdout.splitlines() if line.startswith("ccomm signal frames"))
         lua_errors = [line.strip() for line in r.stdout.splitlines() + r.stderr.splitlines()

@@ -10,19 +10,19 @@ while dumpcap captures the control node's eth0.
 Checks per transport: every ccomm frame decodes without an error or warning, with the
 signals.xml loaded (so config_hash matches the file and every entry matches its signal:
 producer, type, count, kind); each node's entries name exactly the signals it produces
-(read from the XML here, independently of the dissector); the frames use the expected
+(from `ccommd --check --json` here: the dissector only names what it is given); the frames use the expected
 encapsulation; frame sequence numbers per (sender, dest) are contiguous (the capture is
 complete and seq is decoded right); and the capture holds at least every frame the
 daemons counted as sent (ccomm stats frames_tx) while ccomm-latency ran.
 """
 import argparse
 import glob
+import json
 import os
 import signal
 import subprocess
 import sys
 import time
-import xml.etree.ElementTree as ET
 
 import wslib
 
@@ -46,20 +46,19 @@ def import_harness():
     raise RuntimeError("no harness.py with NodePair in the tree")
 
 
-def producers():
-    """signal id -> (name, producer node id, type, count, kind), from the XML itself."""
-    root = ET.parse(CONFIG).getroot()
-    nodes = [n.get("name") for n in root.iter("node")]
-    out = {}
-    for i, s in enumerate(root.iter("signal")):
-        out[i] = (s.get("name"), nodes.index(s.get("producer")), s.get("type"), int(s.get("count", "1")),
-                  s.get("kind", "state"))
+def resolved(bin_dir):
+    """The configuration as ccommd resolves it (`ccommd --check --json`)."""
+    r = subprocess.run([os.path.join(bin_dir, "ccommd"), "--check", CONFIG, "--json"], capture_output=True,
+                       text=True, check=True)
+    return json.loads(r.stdout)
+
+
+def producers(cfg):
+    """signal id -> (name, producer node id, type, count, kind)."""
+    nodes = [n["name"] for n in cfg["nodes"]]
+    out = {s["id"]: (s["name"], nodes.index(s["producer"]), s["type"], s["count"], s["kind"])
+           for s in cfg["signals"]}
     return nodes, out
-
-
-def config_hash(bin_dir):
-    r = subprocess.run([os.path.join(bin_dir, "ccommd"), "--check", CONFIG], capture_output=True, text=True)
-    return r.stdout.strip().rsplit("hash ", 1)[-1].rstrip(")")
 
 
 def frames_tx(stats):
@@ -102,7 +101,7 @@ def analyse(ts, pcap, transport, sent, nodes, signals, want_hash):
               "ccomm.entry.signal", "ccomm.entry.type", "ccomm.entry.count", "ccomm.entry.flags",
               "ccomm.decode_error", "_ws.expert.message", "_ws.expert.severity", "_ws.lua.text",
               "eth.type", "udp.dstport"]
-    pkts, _ = ts.fields(pcap, fields, ["-o", "ccomm.config:" + ts.readable(CONFIG), "-Y", "ccomm"])
+    pkts, _ = ts.fields(pcap, fields, ["-o", ts.config(CONFIG), "-Y", "ccomm"])
     types = {"double": "6", "float": "5", "int64": "4", "uint32": "3", "int32": "2", "bool": "1"}
     bad, seqs, data, entries, encaps = [], {}, {}, {}, set()
     for p in pkts:
@@ -163,8 +162,9 @@ def main():
             print("Bail out! %s missing in %s (build first, set CCOMM_BUILD_DIR)" % (tool, harness.BIN))
             return 1
     ts = wslib.Tshark(args.workdir)
-    nodes, signals = producers()
-    want_hash = config_hash(harness.BIN)
+    cfg = resolved(harness.BIN)
+    nodes, signals = producers(cfg)
+    want_hash = cfg["hash"]
     for transport in ("raw", "udp"):
         pcap, sent = capture(harness, transport, args.seconds, args.workdir, ts)
         analyse(ts, pcap, transport, sent, nodes, signals, want_hash)

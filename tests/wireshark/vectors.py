@@ -252,7 +252,7 @@ def main():
     pcap = os.path.join(work, "vectors-config.pcap")
     wslib.write_pcap(pcap, [wslib.udp(f) for f in config_frames()])
     golden(ts, pcap, "vectors-config.txt", update,
-           ["-o", "ccomm.config:" + ts.readable(os.path.join(wslib.ROOT, "dist", "signals.xml"))])
+           ["-o", ts.config(os.path.join(wslib.ROOT, "dist", "signals.xml"))])
     return 1 if failures else 0
 
 

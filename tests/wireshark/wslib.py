@@ -111,6 +111,18 @@ class Tshark:
         os.chmod(path, 0o644)
         return path
 
+    def config(self, xml_path):
+        """The -o option loading `xml_path` into the dissector: the configuration as ccommd
+        resolves it (`ccommd --check XML --json`, $CCOMM_BUILD_DIR/bin/ccommd), in HOME."""
+        ccommd = os.path.join(os.environ["CCOMM_BUILD_DIR"], "bin", "ccommd")
+        r = subprocess.run([ccommd, "--check", xml_path, "--json"], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("ccommd --check %s --json: %s" % (xml_path, r.stderr))
+        out = os.path.join(self.home, os.path.basename(xml_path) + ".json")
+        with open(out, "w") as f:
+            f.write(r.stdout)
+        return "ccomm.config:" + self.readable(out)
+
     def fields(self, pcap, names, extra=()):
         """One dict per packet: field -> list of values (tshark -T json -e)."""
         args = ["-r", self.readable(pcap), "-T", "json"] + list(extra)

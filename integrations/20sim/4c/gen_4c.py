@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""Generates the 20-sim 4C I/O component of one ccomm node from signals.xml.
+"""Generates the 20-sim 4C I/O component of one ccomm node from signals.xml (as ccommd
+reads it: `ccommd --check FILE --json`; $CCOMM_CCOMMD names the ccommd to run).
 
     gen_4c.py [--node NODE] SIGNALS.XML [NODE] OUTDIR
 
@@ -21,16 +22,14 @@ ccomm4c_output(). Exit status: 0, or 2 for a configuration the driver cannot ser
 """
 from __future__ import annotations
 
+import json
+import os
 import re
+import shutil
+import subprocess
 import sys
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-
-TYPES = {  # name -> (ccomm_type constant, bytes)
-    "bool": ("CCOMM_BOOL", 1), "int32": ("CCOMM_INT32", 4), "uint32": ("CCOMM_UINT32", 4),
-    "int64": ("CCOMM_INT64", 8), "float": ("CCOMM_FLOAT", 4), "double": ("CCOMM_DOUBLE", 8),
-}
 
 
 class ConfigError(Exception):
@@ -40,55 +39,40 @@ class ConfigError(Exception):
 @dataclass
 class Signal:
     name: str
-    type: str
+    type: str  #: "double", ...: ccomm_type_name(); the C constant is CCOMM_ + its upper case
     count: int
+    value_bytes: int
     is_event: bool
     producer: str
     consumers: list[str]
-    line: int
 
 
-def _split(v: str) -> list[str]:
-    return [x for x in re.split(r"[\s,]+", v.strip()) if x]
+def ccommd() -> str:
+    """The ccommd whose parser reads signals.xml: $CCOMM_CCOMMD, else on PATH, else the
+    installed one."""
+    for p in (os.environ.get("CCOMM_CCOMMD"), shutil.which("ccommd"), "/usr/sbin/ccommd",
+              "/usr/local/sbin/ccommd"):
+        if p and os.access(p, os.X_OK):
+            return p
+    raise ConfigError("ccommd not found (it parses signals.xml for the generator): install it "
+                      "or set CCOMM_CCOMMD")
 
 
 def load(path: Path) -> tuple[list[str], list[Signal]]:
-    """Reads nodes and signals; the C++ loader (ccommd --check) is the full validator,
-    this checks what the generated code depends on."""
-    try:
-        # RapidXML (ccommd) accepts "--" inside comments, strict XML parsers do not:
-        # drop comments first so both read the same files.
-        text = re.sub(r"<!--.*?-->", lambda m: "\n" * m.group(0).count("\n"),
-                      path.read_text(encoding="utf-8"), flags=re.S)
-        root = ET.fromstring(text)
-    except ET.ParseError as e:
-        raise ConfigError(f"{path}: {e}") from e
-    if root.tag != "ccomm":
-        raise ConfigError(f"{path}: root element is <{root.tag}>, expected <ccomm>")
-    nodes = [n.get("name", "") for n in root.findall("node")]
+    """Nodes and signals of `path` as ccommd resolves them (`ccommd --check FILE --json`):
+    the one parser of signals.xml; its errors (FILE:LINE) are the generator's."""
+    r = subprocess.run([ccommd(), "--check", str(path), "--json"], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise ConfigError((r.stderr or r.stdout).strip() or f"ccommd --check {path} failed")
+    cfg = json.loads(r.stdout)
+    nodes = [n["name"] for n in cfg["nodes"]]
     signals = []
-    for i, s in enumerate(root.findall("signal")):
-        name = s.get("name", "")
-        where = f"{path}: signal {name or '#' + str(i)}"
-        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", name):
-            raise ConfigError(f"{where}: name must be an identifier")
-        t = s.get("type", "double")
-        if t not in TYPES:
-            raise ConfigError(f"{where}: unknown type '{t}'")
-        try:
-            count = int(s.get("count", "1"))
-        except ValueError as e:
-            raise ConfigError(f"{where}: count is not a number") from e
-        if count < 1:
-            raise ConfigError(f"{where}: count must be at least 1")
-        kind = s.get("kind", "state")
-        if kind not in ("state", "event"):
-            raise ConfigError(f"{where}: kind must be state or event")
-        producer = s.get("producer", "")
-        if producer not in nodes:
-            raise ConfigError(f"{where}: producer '{producer}' is not a <node>")
-        signals.append(Signal(name, t, count, kind == "event", producer,
-                              _split(s.get("consumers", "")), i))
+    for s in cfg["signals"]:
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", s["name"]):
+            raise ConfigError(f"{path}:{s['line']}: signal {s['name']}: the 4C component needs an "
+                              "identifier as its name")
+        signals.append(Signal(s["name"], s["type"], s["count"], s["value_bytes"], s["kind"] == "event",
+                              s["producer"], s["consumers"]))
     return nodes, signals
 
 
@@ -186,10 +170,10 @@ def generate(config: Path, node: str, out: Path) -> None:
     (out / "ccomm_4c.h").write_text("\n".join(h) + "\n")
 
     # ---------------------------------------------------------------- driver
-    max_bytes = max(s.count * TYPES[s.type][1] for s in readable)
+    max_bytes = max(s.value_bytes for s in readable)
     rows = []
     for s in readable:
-        rows.append(f"    {{{c_str(s.name)}, {TYPES[s.type][0]}, {s.count}u, {s.count * TYPES[s.type][1]}u, "
+        rows.append(f"    {{{c_str(s.name)}, CCOMM_{s.type.upper()}, {s.count}u, {s.value_bytes}u, "
                     f"{1 if s.is_event else 0}, {1 if s in writable else 0}}},")
     in_rows = [f"    {{{p[2]}, {p[3]}u, {c_str(p[0])}}}," for p in in_ports]
     out_rows = [f"    {{{p[2]}, {p[3]}u, {c_str(p[0])}}}," for p in out_ports] or ["    {-1, 0u, \"\"},"]
@@ -461,7 +445,6 @@ const char* ccomm4c_output_name(int port) {{
 
 def main(argv: list[str]) -> int:
     import argparse
-    import os
     import socket
 
     ap = argparse.ArgumentParser(prog="gen_4c.py", description=__doc__.split("\n\n")[0])

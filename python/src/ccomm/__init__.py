@@ -18,6 +18,7 @@ from ._native import LibraryNotFoundError, find_library, library_path
 from ._errors import (
     BusyError,
     CcommError,
+    CorruptError,
     DaemonNotRunningError,
     InvalidArgumentError,
     NotFoundError,
@@ -36,7 +37,7 @@ from .history import History, HistoryReading
 __version__ = "0.1.0"
 
 __all__ = [
-    "BusyError", "CcommError", "Client", "DaemonNotRunningError", "History", "HistoryReading",
+    "BusyError", "CcommError", "Client", "CorruptError", "DaemonNotRunningError", "History", "HistoryReading",
     "InvalidArgumentError",
     "LibraryNotFoundError",
     "NotFoundError", "NotProducerError", "QueueFullError", "Reading", "RetiredError", "Signal",
@@ -46,6 +47,6 @@ __all__ = [
 
 
 def open(node: "str | None" = None, *, no_doorbell: bool = False,  # noqa: A001
-         check_daemon: bool = True) -> Client:
+         batch: bool = False, check_daemon: bool = True) -> Client:
     """Client(node): attaches to the node's ccommd segment."""
-    return Client(node, no_doorbell=no_doorbell, check_daemon=check_daemon)
+    return Client(node, no_doorbell=no_doorbell, batch=batch, check_daemon=check_daemon)

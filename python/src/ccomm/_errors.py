@@ -50,20 +50,36 @@ class RetiredError(CcommError):
     """CCOMM_E_RETIRED: ccommd replaced the segment (new configuration): reopen."""
 
 
+class CorruptError(CcommError):
+    """CCOMM_E_CORRUPT: the value in shared memory failed its check (the copy is skipped)."""
+
+
 class DaemonNotRunningError(CcommError, ConnectionError):
     """A write reached shared memory but ccommd is not running (no heartbeat for a
     second): nothing forwards the value to other nodes or judges its freshness there. A
     restarted ccommd makes a new segment; this client then gets RetiredError."""
 
 
+# The codes the record and replay loops compare results with (they raise no exception).
+E_FULL, E_BUSY, E_CORRUPT = -5, -6, -10
+
 _ERRORS = {-1: InvalidArgumentError, -2: NotFoundError, -3: TypeMismatchError,
-           -4: NotProducerError, -5: QueueFullError, -6: BusyError, -7: SystemCallError,
-           -8: VersionError, -9: RetiredError}
+           -4: NotProducerError, E_FULL: QueueFullError, E_BUSY: BusyError, -7: SystemCallError,
+           -8: VersionError, -9: RetiredError, E_CORRUPT: CorruptError}
+
+
+def error_text(code: int) -> str:
+    """ccomm_strerror(code)."""
+    msg: "bytes | None" = _native.lib().ccomm_strerror(code)
+    return msg.decode() if msg else f"error {code}"
+
+
+def error(code: int, what: str) -> CcommError:
+    """The exception of ccomm error `code` (< 0), its message "what: error text"."""
+    return _ERRORS.get(code, CcommError)(code, f"{what}: {error_text(code)}")
 
 
 def _check(code: int, what: str) -> int:
     if code < 0:
-        msg = _native.lib().ccomm_strerror(code)
-        text = msg.decode() if msg else f"error {code}"
-        raise _ERRORS.get(code, CcommError)(code, f"{what}: {text}")
+        raise error(code, what)
     return code

@@ -1,14 +1,22 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Finds and loads libccomm.so and declares the C API for ctypes."""
+"""Finds and loads libccomm.so and declares the C API for ctypes: the one Python binding
+of ccomm.h. Every public struct of ccomm.h has its ctypes.Structure here (python/tests/
+test_layout.py compiles the header and compares every size and offset), and every
+function its declaration in _declare(). Struct pointers are declared c_void_p, so a caller
+passes ctypes.byref(struct) or a plain address (the record and replay loops pass
+integers: a call then costs one foreign call and no Python object)."""
 from __future__ import annotations
 
 import ctypes
 import ctypes.util
 import os
+import struct
 from pathlib import Path
-from typing import Mapping, Optional, Sequence
+from typing import Any, Dict, Mapping, Optional, Sequence, Type
 
 LIB_NAMES = ("libccomm.so.0", "libccomm.so")
+OPEN_NO_DOORBELL = 0x1  # CCOMM_OPEN_NO_DOORBELL
+OPEN_BATCH = 0x2  # CCOMM_OPEN_BATCH: writes leave together at ccomm_flush()
 
 
 class LibraryNotFoundError(OSError):
@@ -35,6 +43,39 @@ class HistoryInfo(ctypes.Structure):  # ccomm_history_info
     _fields_ = [("seq", ctypes.c_uint64), ("source_time_ns", ctypes.c_uint64),
                 ("receive_time_ns", ctypes.c_uint64), ("overrun", ctypes.c_uint64),
                 ("lost", ctypes.c_uint64)]
+
+
+class SignalStats(ctypes.Structure):  # ccomm_signal_stats
+    _fields_ = [
+        ("writes", ctypes.c_uint64),
+        ("write_errors", ctypes.c_uint64),
+        ("tx", ctypes.c_uint64),
+        ("coalesced", ctypes.c_uint64),
+        ("rx", ctypes.c_uint64),
+        ("lost", ctypes.c_uint64),
+        ("overflow", ctypes.c_uint64),
+        ("stale_transitions", ctypes.c_uint64),
+        ("corrupt", ctypes.c_uint64),
+        ("last_rx_age_ns", ctypes.c_int64),
+        ("stale", ctypes.c_int32),
+        ("fragments_refused", ctypes.c_uint64),
+        ("values_incomplete", ctypes.c_uint64),
+    ]
+
+
+class PeerStats(ctypes.Structure):  # ccomm_peer_stats
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("is_self", ctypes.c_int32),
+        ("alive", ctypes.c_int32),
+        ("frames_rx", ctypes.c_uint64),
+        ("frames_tx", ctypes.c_uint64),
+        ("frames_lost", ctypes.c_uint64),
+        ("frames_reordered", ctypes.c_uint64),
+        ("heartbeats_rx", ctypes.c_uint64),
+        ("down_transitions", ctypes.c_uint64),
+        ("last_rx_age_ns", ctypes.c_int64),
+    ]
 
 
 class SignalDesc(ctypes.Structure):
@@ -94,6 +135,27 @@ class ViewCounters(ctypes.Structure):
         ("summaries_send_errors", ctypes.c_uint64),
         ("summary_ms", ctypes.c_uint32),
     ]
+
+
+# The public structs of ccomm.h by their C name: what the layout test compares.
+STRUCTS: Dict[str, Type[ctypes.Structure]] = {
+    "ccomm_info": Info, "ccomm_signal_desc": SignalDesc, "ccomm_history_cursor": HistoryCursor,
+    "ccomm_history_info": HistoryInfo, "ccomm_signal_stats": SignalStats,
+    "ccomm_peer_stats": PeerStats, "ccomm_view_node": ViewNode,
+    "ccomm_view_signal": ViewSignal, "ccomm_view_counters": ViewCounters,
+}
+
+_STRUCT_CODES: Dict[Any, str] = {ctypes.c_int32: "i", ctypes.c_uint32: "I", ctypes.c_int64: "q",
+                                 ctypes.c_uint64: "Q", ctypes.c_double: "d"}
+
+
+def unpack_format(cls: Type[ctypes.Structure]) -> str:
+    """struct format of a ctypes structure without padding (for struct.unpack_from on the
+    structure itself: one call for every field, as the record loop needs)."""
+    fmt = "<" + "".join(_STRUCT_CODES[t] for _n, t in cls._fields_)  # type: ignore[misc]
+    if struct.calcsize(fmt) != ctypes.sizeof(cls):
+        raise TypeError(f"{cls.__name__} has padding: no struct format")
+    return fmt
 
 
 def _repo_roots(starts: Sequence[Path]) -> list[Path]:
@@ -196,51 +258,43 @@ def library_path() -> str:
 
 
 def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
-    vp, cp, i32, u32 = ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int32, ctypes.c_uint32
-    L.ccomm_open.argtypes = [cp, u32, ctypes.POINTER(vp)]
-    L.ccomm_open.restype = ctypes.c_int
-    L.ccomm_close.argtypes = [vp]
-    L.ccomm_close.restype = None
-    L.ccomm_strerror.argtypes = [ctypes.c_int]
-    L.ccomm_strerror.restype = cp
-    L.ccomm_find.argtypes = [vp, cp]
-    L.ccomm_find.restype = i32
-    L.ccomm_signal_count.argtypes = [vp]
-    L.ccomm_signal_count.restype = ctypes.c_int
-    L.ccomm_describe.argtypes = [vp, i32, ctypes.POINTER(SignalDesc)]
-    L.ccomm_describe.restype = ctypes.c_int
-    L.ccomm_node_name.argtypes = [vp]
-    L.ccomm_node_name.restype = cp
-    L.ccomm_read.argtypes = [vp, i32, vp, ctypes.c_size_t, ctypes.POINTER(Info)]
-    L.ccomm_read.restype = ctypes.c_int
-    L.ccomm_write.argtypes = [vp, i32, vp, ctypes.c_size_t]
-    L.ccomm_write.restype = ctypes.c_int
-    # ctypes releases the GIL during foreign calls: other threads run while this blocks.
-    L.ccomm_wait.argtypes = [vp, ctypes.c_int]
-    L.ccomm_wait.restype = ctypes.c_int
-    L.ccomm_set_time.argtypes = [vp, ctypes.c_int64]
-    L.ccomm_set_time.restype = ctypes.c_int
-    L.ccomm_now.argtypes = []
-    L.ccomm_now.restype = ctypes.c_int64
-    L.ccomm_daemon_alive.argtypes = [vp]
-    L.ccomm_daemon_alive.restype = ctypes.c_int
-    L.ccomm_node_count.argtypes = [vp]
-    L.ccomm_node_count.restype = ctypes.c_int
-    L.ccomm_view_open.argtypes = [vp, ctypes.POINTER(vp)]
-    L.ccomm_view_open.restype = ctypes.c_int
-    L.ccomm_view_close.argtypes = [vp]
-    L.ccomm_view_close.restype = None
-    L.ccomm_view_get_node.argtypes = [vp, ctypes.c_int, ctypes.POINTER(ViewNode)]
-    L.ccomm_view_get_node.restype = ctypes.c_int
-    L.ccomm_view_get_signal.argtypes = [vp, ctypes.c_int, i32, ctypes.POINTER(ViewSignal)]
-    L.ccomm_view_get_signal.restype = ctypes.c_int
-    L.ccomm_view_get_counters.argtypes = [vp, ctypes.POINTER(ViewCounters)]
-    L.ccomm_view_get_counters.restype = ctypes.c_int
-    L.ccomm_history_depth.argtypes = [vp, i32]
-    L.ccomm_history_depth.restype = ctypes.c_int
-    L.ccomm_history_start.argtypes = [vp, i32, u32, ctypes.POINTER(HistoryCursor)]
-    L.ccomm_history_start.restype = ctypes.c_int
-    L.ccomm_history_read.argtypes = [vp, i32, ctypes.POINTER(HistoryCursor), vp, ctypes.c_size_t,
-                                     ctypes.POINTER(HistoryInfo)]
-    L.ccomm_history_read.restype = ctypes.c_int
+    vp, cp, i32, u32, i64 = ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int32, ctypes.c_uint32, ctypes.c_int64
+    sz, c_int = ctypes.c_size_t, ctypes.c_int
+    # name: (argument types, result type); every struct pointer is vp (see the docstring).
+    # The growable structs are filled by the *_sized calls, given ctypes.sizeof of the
+    # structure here (ccomm.h, "Growable structs"): a newer library never writes past it.
+    api: Dict[str, Any] = {
+        "ccomm_open": ([cp, u32, ctypes.POINTER(vp)], c_int),
+        "ccomm_close": ([vp], None),
+        "ccomm_strerror": ([c_int], cp),
+        "ccomm_type_name": ([i32], cp),
+        "ccomm_type_size": ([i32], u32),
+        "ccomm_type_from_name": ([cp], c_int),
+        "ccomm_find": ([vp, cp], i32),
+        "ccomm_signal_count": ([vp], c_int),
+        "ccomm_describe_sized": ([vp, i32, vp, sz], c_int),
+        "ccomm_node_name": ([vp], cp),
+        "ccomm_read": ([vp, i32, vp, sz, vp], c_int),
+        "ccomm_write": ([vp, i32, vp, sz], c_int),
+        "ccomm_flush": ([vp], c_int),
+        # ctypes releases the GIL during foreign calls: other threads run while this blocks.
+        "ccomm_wait": ([vp, c_int], c_int),
+        "ccomm_set_time": ([vp, i64], c_int),
+        "ccomm_now": ([], i64),
+        "ccomm_daemon_alive": ([vp], c_int),
+        "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),
+        "ccomm_node_count": ([vp], c_int),
+        "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
+        "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
+        "ccomm_view_close": ([vp], None),
+        "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),
+        "ccomm_view_get_signal_sized": ([vp, c_int, i32, vp, sz], c_int),
+        "ccomm_view_get_counters_sized": ([vp, vp, sz], c_int),
+        "ccomm_history_depth": ([vp, i32], c_int),
+        "ccomm_history_start": ([vp, i32, u32, vp], c_int),
+        "ccomm_history_read": ([vp, i32, vp, vp, sz, vp], c_int),
+    }
+    for name, (argtypes, restype) in api.items():
+        f = getattr(L, name)
+        f.argtypes, f.restype = argtypes, restype
     return L

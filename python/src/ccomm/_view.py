@@ -18,18 +18,18 @@ def system_view(handle: int) -> Dict[str, Any]:
     _check(L.ccomm_view_open(handle, ctypes.byref(v)), "system view")
     try:
         vc = _native.ViewCounters()
-        _check(L.ccomm_view_get_counters(v, ctypes.byref(vc)), "system view")
+        _check(L.ccomm_view_get_counters_sized(v, ctypes.byref(vc), ctypes.sizeof(vc)), "system view")
         names: List[str] = []
         nodes: List[Dict[str, Any]] = []
         n_signals = L.ccomm_signal_count(handle)
         for n in range(L.ccomm_node_count(handle)):
             vn = _native.ViewNode()
-            _check(L.ccomm_view_get_node(v, n, ctypes.byref(vn)), "system view")
+            _check(L.ccomm_view_get_node_sized(v, n, ctypes.byref(vn), ctypes.sizeof(vn)), "system view")
             names.append(vn.name.decode())
             signals = []
             for s in range(n_signals):
                 vs = _native.ViewSignal()
-                rc = L.ccomm_view_get_signal(v, n, s, ctypes.byref(vs))
+                rc = L.ccomm_view_get_signal_sized(v, n, s, ctypes.byref(vs), ctypes.sizeof(vs))
                 if rc == -2:  # CCOMM_E_NOENT
                     continue  # the node neither produces nor consumes it (or no report yet)
                 _check(rc, "system view")

@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import ctypes
-import enum
 import math
 import time
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, AsyncIterator, Callable, Dict, Iterator, List, Optional, Union
+from typing import TYPE_CHECKING, Any, AsyncIterator, Callable, Dict, Iterator, List, Optional
 
 import numpy as np
 import numpy.typing as npt
@@ -32,76 +30,20 @@ from ._errors import (
     VersionError as VersionError,
 )
 
-Scalar = Union[bool, int, float]
-Value = Union[Scalar, "npt.NDArray[Any]"]
-ValueLike = Union[Scalar, "npt.ArrayLike"]
-
-
-class Status(enum.IntEnum):
-    """What a read says about the value (ccomm_status)."""
-
-    FRESH = 0  #: younger than the signal's stale_after_ms
-    STALE = 1  #: older than stale_after_ms (the safe value if one is configured)
-    NEVER = 2  #: nothing received since the node's segment was created
-    EMPTY = 3  #: event signal: no new event since the last read
-
-
-class SignalType(enum.IntEnum):
-    BOOL = 1
-    INT32 = 2
-    UINT32 = 3
-    INT64 = 4
-    FLOAT = 5
-    DOUBLE = 6
-
-
-_DTYPES: Dict[SignalType, "np.dtype[Any]"] = {
-    SignalType.BOOL: np.dtype(np.bool_),
-    SignalType.INT32: np.dtype(np.int32),
-    SignalType.UINT32: np.dtype(np.uint32),
-    SignalType.INT64: np.dtype(np.int64),
-    SignalType.FLOAT: np.dtype(np.float32),
-    SignalType.DOUBLE: np.dtype(np.float64),
-}
+# The descriptors live in _types; "X as X" keeps ccomm.client.X working (and typed).
+from ._types import STATUS_NAMES as STATUS_NAMES
+from ._types import STRUCT_CODES as STRUCT_CODES
+from ._types import TYPE_FORMATS as TYPE_FORMATS
+from ._types import _DTYPES as _DTYPES
+from ._types import Reading as Reading
+from ._types import Scalar as Scalar
+from ._types import SignalInfo as SignalInfo
+from ._types import SignalType as SignalType
+from ._types import Status as Status
+from ._types import Value as Value
+from ._types import ValueLike as ValueLike
 
 _SAFE_VALUE = 0x1  # CCOMM_INFO_SAFE_VALUE
-_NO_DOORBELL = 0x1  # CCOMM_OPEN_NO_DOORBELL
-
-
-@dataclass(frozen=True)
-class SignalInfo:
-    """Static description of a signal (from signals.xml, as ccommd loaded it)."""
-
-    id: int
-    name: str
-    type: SignalType
-    count: int  #: array length; 1 = scalar
-    value_bytes: int
-    is_event: bool
-    produced_here: bool  #: this node may write it
-    stale_after_ms: int  #: 0 = never stale
-    producer: str
-
-    @property
-    def dtype(self) -> "np.dtype[Any]":
-        return _DTYPES[self.type]
-
-
-@dataclass(frozen=True)
-class Reading:
-    """One read: the value and what ccomm knows about it."""
-
-    value: Optional[Value]  #: scalar for count 1, numpy array otherwise; None if EMPTY
-    status: Status
-    seq: int  #: producer's sequence number (0 = never)
-    age_ns: Optional[int]  #: since the value reached this node; None if never
-    source_time_ns: int  #: producer's CLOCK_MONOTONIC when it wrote the value
-    lost: int  #: values/events of this signal known lost so far
-    safe_value: bool  #: the value is the configured safe value
-
-    @property
-    def fresh(self) -> bool:
-        return self.status == Status.FRESH
 
 
 class Signal:
@@ -230,6 +172,20 @@ class Signal:
         from .history import History
         return History(self, back)
 
+    @property
+    def history_depth(self) -> int:
+        """Values of this signal the node's history tap keeps (0: none, see <node history=>)."""
+        return max(0, int(_native.lib().ccomm_history_depth(self._client._handle(), self.info.id)))
+
+    def stats(self) -> Dict[str, int]:
+        """ccommd's counters of this signal on this node (ccomm_signal_stats: writes, tx,
+        coalesced, rx, lost, stale, ...; what `ccomm stats` prints per signal)."""
+        out = _native.SignalStats()
+        _check(_native.lib().ccomm_get_signal_stats_sized(self._client._handle(), self.info.id, ctypes.byref(out),
+                                                          ctypes.sizeof(out)),
+               f"stats of {self.info.name}")
+        return {name: int(getattr(out, name)) for name, _t in out._fields_}
+
     def read_into(self, out: npt.NDArray[Any]) -> Reading:
         """Reads into `out` (shape (count,), the signal's dtype), allocating no array.
         The Reading's value is `out` (None for EMPTY; `out` then keeps its contents)."""
@@ -277,13 +233,16 @@ class Client:
     are not shared between threads). Closes on exit of a `with` block."""
 
     def __init__(self, node: Optional[str] = None, *, no_doorbell: bool = False,
-                 check_daemon: bool = True) -> None:
+                 batch: bool = False, check_daemon: bool = True) -> None:
         """Attaches to `node` (None: $CCOMM_NODE, else the hostname); NotFoundError if
         its ccommd has not made the segment. With check_daemon (the default), a write
-        while ccommd is not running raises DaemonNotRunningError after writing."""
+        while ccommd is not running raises DaemonNotRunningError after writing. With
+        batch, state writes are held until flush() and then leave together (one frame
+        per control step: CCOMM_OPEN_BATCH)."""
         self._h: Optional[int] = None
-        self._h = self._open(node, _NO_DOORBELL if no_doorbell else 0)
-        self._node_arg, self._flags, self._check_daemon = node, _NO_DOORBELL if no_doorbell else 0, check_daemon
+        flags = (_native.OPEN_NO_DOORBELL if no_doorbell else 0) | (_native.OPEN_BATCH if batch else 0)
+        self._h = self._open(node, flags)
+        self._node_arg, self._flags, self._check_daemon = node, flags, check_daemon
         self._signals: Dict[str, Signal] = {}
         self._waiter: Optional[int] = None  # the handle Signal.wait() waits on
         self._pump = _aio.ChangePump(lambda: self._open(self._node_arg, self._flags))
@@ -301,6 +260,17 @@ class Client:
         if self._h is None:
             raise ValueError("ccomm client is closed")
         return self._h
+
+    @property
+    def handle(self) -> int:
+        """The ccomm_client* as an address, for direct calls through ccomm._native.lib()
+        (the record and replay loops); valid until close()."""
+        return self._handle()
+
+    def flush(self) -> None:
+        """Batch client (Client(batch=True)): hands every state value written since the
+        last flush to ccommd at once (ccomm_flush); otherwise does nothing."""
+        _check(_native.lib().ccomm_flush(self._handle()), "flush")
 
     @property
     def node(self) -> str:
@@ -334,11 +304,13 @@ class Client:
 
     def _describe(self, sid: int) -> SignalInfo:
         d = _native.SignalDesc()
-        _check(_native.lib().ccomm_describe(self._handle(), sid, ctypes.byref(d)), f"describe {sid}")
+        _check(_native.lib().ccomm_describe_sized(self._handle(), sid, ctypes.byref(d), ctypes.sizeof(d)),
+               f"describe {sid}")
         return SignalInfo(id=sid, name=(d.name or b"").decode(), type=SignalType(d.type),
                           count=int(d.count), value_bytes=int(d.value_bytes),
                           is_event=bool(d.is_event), produced_here=bool(d.produced_here),
-                          stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode())
+                          stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode(),
+                          consumed_here=bool(d.consumed_here))
 
     def signals(self) -> List[SignalInfo]:
         """Every signal of the system, in configuration order."""

@@ -48,9 +48,10 @@ class History:
         self._signal = signal
         info = signal.info
         self.depth = int(_native.lib().ccomm_history_depth(signal._client._handle(), info.id))
-        self._cursor = _native.HistoryCursor()
+        #: the ccomm_history_cursor (for direct ccomm_history_read calls, as ccomm-record makes)
+        self.cursor = _native.HistoryCursor()
         _check(_native.lib().ccomm_history_start(signal._client._handle(), info.id, back,
-                                                 ctypes.byref(self._cursor)),
+                                                 ctypes.byref(self.cursor)),
                f"history of {info.name}")
         self._buf = (ctypes.c_ubyte * info.value_bytes)()
         self._view: npt.NDArray[Any] = np.frombuffer(memoryview(self._buf), dtype=info.dtype,
@@ -60,12 +61,12 @@ class History:
     @property
     def overrun(self) -> int:
         """Values this reader missed because it fell more than `depth` values behind."""
-        return int(self._cursor.overrun)
+        return int(self.cursor.overrun)
 
     def read(self) -> Optional[HistoryReading]:
         """The next value, or None when the reader has caught up."""
         s = self._signal
-        r = _native.lib().ccomm_history_read(s._client._handle(), s.info.id, ctypes.byref(self._cursor),
+        r = _native.lib().ccomm_history_read(s._client._handle(), s.info.id, ctypes.byref(self.cursor),
                                              self._buf, s.info.value_bytes, ctypes.byref(self._info))
         if _check(r, f"history of {s.info.name}") == _EMPTY:
             return None

@@ -28,7 +28,9 @@ import time
 from typing import Any, Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
-from .mcap_io.capi import E_CORRUPT, HISTORY_INFO_FORMAT, INFO_FORMAT, CcommCallError, Handle, SignalDesc
+from . import _native
+from ._errors import E_CORRUPT, CcommError, error_text
+from .client import Client, SignalInfo
 from .mcap_io.schema import RECORD
 
 EXAMPLES = """\
@@ -93,7 +95,7 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     return a
 
 
-def select_signals(all_signals: List[SignalDesc], patterns: List[str], node: str) -> List[SignalDesc]:
+def select_signals(all_signals: List[SignalInfo], patterns: List[str], node: str) -> List[SignalInfo]:
     """The selected signals; raises ValueError with a clear message."""
     readable = [d for d in all_signals if d.readable_here]
     words = [w.strip() for arg in patterns for w in arg.split(",") if w.strip()]
@@ -101,7 +103,7 @@ def select_signals(all_signals: List[SignalDesc], patterns: List[str], node: str
         if not readable:
             raise ValueError(f"node '{node}' neither produces nor receives any signal: nothing to record")
         return readable
-    chosen: List[SignalDesc] = []
+    chosen: List[SignalInfo] = []
     for w in words:
         if any(ch in w for ch in "*?["):
             hits = [d for d in readable if fnmatch.fnmatchcase(d.name, w)]
@@ -155,23 +157,25 @@ class ReadDelay:
     over_1ms = 0
 
 
-def use_history(h: Handle, d: SignalDesc) -> bool:
+def use_history(c: Client, d: SignalInfo) -> bool:
     """A state this node receives, and the node keeps history of it (<node history=>)."""
-    return not d.is_event and d.consumed_here and h.history_depth(d.id) > 0
+    return not d.is_event and d.consumed_here and c.signal(d.name).history_depth > 0
 
 
-def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, duration: float, stop: List[int],
+def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, duration: float, stop: List[int],
             writer_alive: Callable[[], bool], delay: ReadDelay) -> int:
     """Reads every new value of `sigs` until stopped; returns the exit status. `cursors`:
     a history cursor per signal read through the node's history tap, else None."""
-    handle, read, wait, now, set_time = h.h, h.read, h.wait, h.now, h.set_time
-    history_read = h.history_read
-    info = (ctypes.c_ubyte * struct.calcsize(INFO_FORMAT))()
+    # The raw calls, bound once; pointers passed as plain addresses (see ccomm._native).
+    L, handle = _native.lib(), c.handle
+    read, wait, now, set_time = L.ccomm_read, L.ccomm_wait, L.ccomm_now, L.ccomm_set_time
+    history_read = L.ccomm_history_read
+    info = _native.Info()
     info_addr = ctypes.addressof(info)
-    unpack_info = struct.Struct(INFO_FORMAT).unpack_from
-    hinfo = (ctypes.c_ubyte * struct.calcsize(HISTORY_INFO_FORMAT))()
+    unpack_info = struct.Struct(_native.unpack_format(_native.Info)).unpack_from
+    hinfo = _native.HistoryInfo()
     hinfo_addr = ctypes.addressof(hinfo)
-    unpack_hinfo = struct.Struct(HISTORY_INFO_FORMAT).unpack_from
+    unpack_hinfo = struct.Struct(_native.unpack_format(_native.HistoryInfo)).unpack_from
     pack = RECORD.pack
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
     # A history cursor per received state when the node keeps history (from the newest
@@ -205,7 +209,7 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
                     if r == E_CORRUPT:  # a damaged copy: skipped, counted in the overrun
                         continue
                     if r < 0:
-                        print(f"record: reading {sigs[i].name} failed: {h.strerror(r)}", file=sys.stderr)
+                        print(f"record: reading {sigs[i].name} failed: {error_text(r)}", file=sys.stderr)
                         return 1
                     if r != 0:  # EMPTY: caught up
                         break
@@ -227,7 +231,7 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
             while True:
                 r = read(handle, sid, addr, size, info_addr)
                 if r < 0:
-                    print(f"record: reading {sigs[i].name} failed: {h.strerror(r)}", file=sys.stderr)
+                    print(f"record: reading {sigs[i].name} failed: {error_text(r)}", file=sys.stderr)
                     return 1
                 if r >= 2:  # NEVER (no value yet) or EMPTY (no new event)
                     break
@@ -266,12 +270,14 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
 def record(a: argparse.Namespace) -> int:
     from .mcap_io.writer import WriterOptions, run_writer
     try:
-        h = Handle(a.node)
-    except (CcommCallError, OSError) as e:
+        c = Client(a.node, check_daemon=False)
+        node = c.node
+        all_signals = c.signals()
+    except (CcommError, OSError) as e:
         print(f"record: {e}", file=sys.stderr)
         return 1
     try:
-        sigs = select_signals(h.signals(), a.signals, h.node)
+        sigs = select_signals(all_signals, a.signals, node)
     except ValueError as e:
         print(f"record: {e}", file=sys.stderr)
         return 2
@@ -279,25 +285,25 @@ def record(a: argparse.Namespace) -> int:
         for d in sigs:
             print(f"{d.name}\t{d.type_text}\t{'event' if d.is_event else 'state'}\tfrom {d.producer}")
         return 0
-    if not h.daemon_alive():
-        print(f"record: warning: ccommd of node '{h.node}' shows no heartbeat; recording what "
+    if not c.daemon_alive:
+        print(f"record: warning: ccommd of node '{node}' shows no heartbeat; recording what "
               "the segment holds", file=sys.stderr)
-    polled = [d.name for d in sigs if not d.is_event and d.consumed_here and not use_history(h, d)]
+    polled = [d.name for d in sigs if not d.is_event and d.consumed_here and not use_history(c, d)]
     if polled:
-        print(f"record: warning: node '{h.node}' keeps no history of the states it receives "
+        print(f"record: warning: node '{node}' keeps no history of the states it receives "
               f"({len(polled)} selected, e.g. {polled[0]}): they are polled, and a value replaced before "
               f"the recorder reads it is missed (a gap in the file). Give the node a history tap in "
-              f'signals.xml (<node name="{h.node}" history="1024" ...>) to record every value.',
+              f'signals.xml (<node name="{node}" history="1024" ...>) to record every value.',
               file=sys.stderr)
-    output = a.output or time.strftime(f"ccomm-{h.node}-%Y%m%d-%H%M%S.mcap")
+    output = a.output or time.strftime(f"ccomm-{node}-%Y%m%d-%H%M%S.mcap")
     offset = time.clock_gettime_ns(time.CLOCK_REALTIME) - time.clock_gettime_ns(time.CLOCK_MONOTONIC)
-    opts = WriterOptions(output=output, signals=sigs, node=h.node, compression=a.compression,
+    opts = WriterOptions(output=output, signals=sigs, node=node, compression=a.compression,
                          chunk_size=a.chunk_size, rotate_bytes=int(a.rotate_size * 1e6),
                          rotate_seconds=a.rotate_seconds, clock_offset_ns=offset,
                          progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns())
     # History cursors from the newest value kept (what polling would read first), made
     # before the start message: every value that arrives after it is recorded.
-    cursors = [h.history_cursor(d.id, 1) if use_history(h, d) else None for d in sigs]
+    cursors = [c.signal(d.name).history(1).cursor if use_history(c, d) else None for d in sigs]
     rfd, wfd = os.pipe()
     try:  # room for about half a second of values at 100 000 values/s
         import fcntl
@@ -324,7 +330,7 @@ def record(a: argparse.Namespace) -> int:
     for s in (signal.SIGINT, signal.SIGTERM):
         signal.signal(s, lambda *_: stop.append(1))
     if a.progress != "none":
-        print(f"record: node {h.node}, {len(sigs)} signals -> {output} (^C to stop)", file=sys.stderr)
+        print(f"record: node {node}, {len(sigs)} signals -> {output} (^C to stop)", file=sys.stderr)
     _set_priority(a.priority)
     gc.disable()  # the loop makes no cycles; a collection pause could miss a value
     ended: List[int] = []
@@ -338,12 +344,12 @@ def record(a: argparse.Namespace) -> int:
         return not ended
 
     try:
-        code = capture(h, sigs, cursors, wfd, a.duration, stop, writer_alive, delay)
+        code = capture(c, sigs, cursors, wfd, a.duration, stop, writer_alive, delay)
     except BrokenPipeError:
         code = 1
     finally:
         os.close(wfd)
-        h.close()
+        c.close()
     if not ended:
         ended.append(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]))
     wcode = ended[0]

@@ -16,8 +16,9 @@ import time
 from typing import TYPE_CHECKING, Dict, List, Optional, Sequence, Tuple
 
 from .mcap_io import require_mcap
-from .mcap_io.capi import (E_BUSY, E_FULL, OPEN_BATCH, SIGNAL_STATS_BYTES, SIGNAL_STATS_TX_OFFSET,
-                           CcommCallError, Handle, SignalDesc)
+from . import _native
+from ._errors import E_BUSY, E_FULL, CcommError, error
+from .client import Client, SignalInfo
 
 if TYPE_CHECKING:
     from .mcap_io.recording import Recording
@@ -66,11 +67,11 @@ class Refusal(Exception):
     """The recording does not fit this node: exit 2, nothing written."""
 
 
-def plan(rec: "Recording", descs: List[SignalDesc], patterns: List[str],
-         node: str) -> Tuple[List[Tuple[SignalDesc, str]], List[str]]:
+def plan(rec: "Recording", descs: List[SignalInfo], patterns: List[str],
+         node: str) -> Tuple[List[Tuple[SignalInfo, str]], List[str]]:
     """(signals to replay as (desc, recorded name), notes about skipped ones)."""
     words = [w.strip() for arg in patterns for w in arg.split(",") if w.strip()]
-    by_name: Dict[str, SignalDesc] = {d.name: d for d in descs}
+    by_name: Dict[str, SignalInfo] = {d.name: d for d in descs}
     named = {w for w in words if not any(c in w for c in "*?[")}
     for w in named:
         if w not in rec.signals:
@@ -86,7 +87,7 @@ def plan(rec: "Recording", descs: List[SignalDesc], patterns: List[str],
         if d is None:
             raise Refusal(f"signal '{name}' of {rec.path} does not exist on node '{node}': the "
                           "recording is of another configuration (select signals with --signals)")
-        if d.type != rs.type or d.count != rs.count or d.is_event != rs.is_event:
+        if d.type_name != rs.type or d.count != rs.count or d.is_event != rs.is_event:
             def kind(event: bool) -> str:
                 return "event" if event else "state"
             raise Refusal(f"signal '{name}' was recorded as {kind(rs.is_event)} {rs.type_text}, but "
@@ -111,25 +112,27 @@ def _percentile(sorted_vals: List[int], q: float) -> int:
     return sorted_vals[min(len(sorted_vals) - 1, int(q * len(sorted_vals)))]
 
 
-def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, loop: bool,
+def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, loop: bool,
            stop: List[int], quiet: bool) -> Tuple[int, List[int]]:
     """Writes the timeline ((source time, seq, signal id, value)); returns (values written,
     lateness of each write in ns)."""
-    handle, write, now = h.h, h.write, time.monotonic_ns
-    assert handle is not None, "replay needs an open handle"
+    # The raw calls, bound once; pointers passed as plain addresses (see ccomm._native).
+    L, handle, now = _native.lib(), c.handle, time.monotonic_ns
+    write = L.ccomm_write
     # A state is sent as its newest value: a step flushed before ccommd took the previous
     # one would replace it unsent (counted `coalesced` on this node). So each flush first
     # waits, bounded, until ccommd has taken the previous step: its `tx` counter of a
     # signal of that step moved. Costs two stats reads a step; waits only when replay runs
     # late and steps follow each other within ccommd's wake-up time.
-    stats = (ctypes.c_ubyte * SIGNAL_STATS_BYTES)()
+    stats = _native.SignalStats()
     stats_addr = ctypes.addressof(stats)
-    get_stats, raw_flush = h.get_signal_stats, h.flush
+    get_stats, raw_flush = L.ccomm_get_signal_stats_sized, L.ccomm_flush
+    stats_size = ctypes.sizeof(stats)
     probe = [-1, 0]  # a signal of the last flushed step, its tx before that flush
 
     def tx_of(sid: int) -> int:
-        get_stats(handle, sid, stats_addr)
-        return int.from_bytes(bytes(stats[SIGNAL_STATS_TX_OFFSET:SIGNAL_STATS_TX_OFFSET + 8]), "little")
+        get_stats(handle, sid, stats_addr, stats_size)
+        return int(stats.tx)
 
     no_tx: "set[int]" = set()  # signals ccommd did not send within the bound (not forwarded): no probe
 
@@ -182,7 +185,7 @@ def replay(h: Handle, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
                 tries += 1
                 r = write(handle, sid, data, len(data))
             if r < 0:
-                raise CcommCallError(r, f"writing signal {sid} failed: {h.strerror(r)}")
+                raise error(r, f"writing signal {sid} failed")
             late.append(now() - target)
             written += 1
             if not quiet and now() - last_report >= 1_000_000_000:
@@ -203,9 +206,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     from .mcap_io.recording import RecordingError, load
     words = [w.strip() for arg in a.signals for w in arg.split(",") if w.strip()]
     try:
-        h = Handle(a.node, OPEN_BATCH)
-        descs = h.signals()
-    except (CcommCallError, OSError) as e:
+        c = Client(a.node, batch=True, check_daemon=False)
+        node = c.node
+        descs = c.signals()
+    except (CcommError, OSError) as e:
         print(f"replay: {e}", file=sys.stderr)
         return 1
     produced = {d.name for d in descs if d.produced_here}
@@ -215,14 +219,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     try:
         rec = load(a.file, wanted)
-        chosen, skipped = plan(rec, descs, a.signals, h.node)
+        chosen, skipped = plan(rec, descs, a.signals, node)
     except (RecordingError, Refusal) as e:
         print(f"replay: {e}", file=sys.stderr)
         return 2
     timeline = sorted((t, seq, d.id, data) for d, name in chosen for t, seq, data in rec.signals[name].values)
     if not a.quiet:
         print(f"replay: {len(timeline)} values of {len(chosen)} signals from {a.file} "
-              f"(recorded on '{rec.node}') into node '{h.node}'", file=sys.stderr)
+              f"(recorded on '{rec.node}') into node '{node}'", file=sys.stderr)
         if skipped:
             print(f"replay: skipped {len(skipped)} signals other nodes produce: "
                   f"{', '.join(skipped[:8])}{' ...' if len(skipped) > 8 else ''}", file=sys.stderr)
@@ -243,13 +247,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     gc.freeze()
     gc.disable()
     try:
-        written, late = replay(h, timeline, a.rate, a.loop, stop, a.quiet)
-    except CcommCallError as e:
+        written, late = replay(c, timeline, a.rate, a.loop, stop, a.quiet)
+    except CcommError as e:
         print(f"\nreplay: {e}", file=sys.stderr)
         return 1
     finally:
         gc.enable()
-        h.close()
+        c.close()
     late.sort()
     stats = {"values": written, "signals": len(chosen), "late_p50_ns": _percentile(late, 0.5),
              "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0}

@@ -88,6 +88,26 @@ typedef struct ccomm_info {
 typedef enum ccomm_type {
   CCOMM_BOOL = 1, CCOMM_INT32 = 2, CCOMM_UINT32 = 3, CCOMM_INT64 = 4, CCOMM_FLOAT = 5, CCOMM_DOUBLE = 6
 } ccomm_type;
+/** The name of a ccomm_type as signals.xml writes it (bool, int32, uint32, int64, float,
+ *  double); NULL for another value. Tools take type names from here. */
+CCOMM_API const char* ccomm_type_name(int32_t type);
+/** Bytes of one element of a ccomm_type (bool: 1); 0 for another value. */
+CCOMM_API uint32_t ccomm_type_size(int32_t type);
+/** The ccomm_type called `name` ("double"), or CCOMM_E_INVAL. */
+CCOMM_API int ccomm_type_from_name(const char* name);
+
+/*
+ * Growable structs. ccomm_signal_desc, ccomm_signal_stats, ccomm_peer_stats and the
+ * ccomm_view_* structs gain fields only at their end. The calls that fill them take the
+ * caller's sizeof (the *_sized entry points; the plain names below are macros passing
+ * sizeof(*out)): the library fills that many bytes and zeroes any it has no field for, so
+ * a program keeps working against a newer library (and a newer one against an older).
+ * The plain symbols stay for programs built before: ccomm_get_signal_stats fills the
+ * 0.1.0 layout (80 bytes), the others the layout of this header, which they had then.
+ * ccomm_info, ccomm_history_cursor and ccomm_history_info are fixed: the real-time calls
+ * take no size. CCOMM_E_INVAL if `size` is smaller than the struct in this header (the
+ * first layout the *_sized calls had).
+ */
 
 /** Static description of a signal. */
 typedef struct ccomm_signal_desc {
@@ -119,6 +139,8 @@ CCOMM_API ccomm_signal ccomm_find(ccomm_client* c, const char* name);
 CCOMM_API int ccomm_signal_count(const ccomm_client* c);
 /** Describes a signal; CCOMM_E_INVAL for a bad handle. */
 CCOMM_API int ccomm_describe(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out);
+CCOMM_API int ccomm_describe_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out, size_t size);
+#define ccomm_describe(c, s, out) ccomm_describe_sized((c), (s), (out), sizeof(*(out)))
 /** Name of the node this handle is attached to. */
 CCOMM_API const char* ccomm_node_name(const ccomm_client* c);
 
@@ -247,6 +269,9 @@ typedef struct ccomm_signal_stats {
 } ccomm_signal_stats;
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or signal. */
 CCOMM_API int ccomm_get_signal_stats(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out);
+CCOMM_API int ccomm_get_signal_stats_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_stats* out,
+                                           size_t size);
+#define ccomm_get_signal_stats(c, s, out) ccomm_get_signal_stats_sized((c), (s), (out), sizeof(*(out)))
 
 /** Number of nodes in the system (node indexes are 0..n-1, in signals.xml order). */
 CCOMM_API int ccomm_node_count(const ccomm_client* c);
@@ -265,6 +290,8 @@ typedef struct ccomm_peer_stats {
 } ccomm_peer_stats;
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or node index. */
 CCOMM_API int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out);
+CCOMM_API int ccomm_get_peer_stats_sized(const ccomm_client* c, int node, ccomm_peer_stats* out, size_t size);
+#define ccomm_get_peer_stats(c, node, out) ccomm_get_peer_stats_sized((c), (node), (out), sizeof(*(out)))
 
 /**
  * Daemon-wide counter `index` (0, 1, ... until CCOMM_E_INVAL): its name (e.g.
@@ -315,6 +342,8 @@ typedef struct ccomm_view_node {
  *  was being rewritten throughout ~50 ms of waiting (ccommd stopped mid-rewrite). The view
  *  calls may sleep: they are for monitoring tools, not for a control loop. */
 CCOMM_API int ccomm_view_get_node(const ccomm_view* v, int node, ccomm_view_node* out);
+CCOMM_API int ccomm_view_get_node_sized(const ccomm_view* v, int node, ccomm_view_node* out, size_t size);
+#define ccomm_view_get_node(v, node, out) ccomm_view_get_node_sized((v), (node), (out), sizeof(*(out)))
 
 /** One signal as node `node` reports it. */
 typedef struct ccomm_view_signal {
@@ -332,6 +361,9 @@ typedef struct ccomm_view_signal {
 /** Fills `out`; CCOMM_E_NOENT if that node does not report (produce or consume) the signal
  *  or no summary of it arrived yet; CCOMM_E_INVAL for a bad handle, node or signal. */
 CCOMM_API int ccomm_view_get_signal(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out);
+CCOMM_API int ccomm_view_get_signal_sized(const ccomm_view* v, int node, ccomm_signal s, ccomm_view_signal* out,
+                                          size_t size);
+#define ccomm_view_get_signal(v, node, s, out) ccomm_view_get_signal_sized((v), (node), (s), (out), sizeof(*(out)))
 
 /** Summary traffic of this node's ccommd (counters only grow). */
 typedef struct ccomm_view_counters {
@@ -342,6 +374,8 @@ typedef struct ccomm_view_counters {
   uint32_t summary_ms;         /**< this node's <network summary_ms> (0: it sends none) */
 } ccomm_view_counters;
 CCOMM_API int ccomm_view_get_counters(const ccomm_view* v, ccomm_view_counters* out);
+CCOMM_API int ccomm_view_get_counters_sized(const ccomm_view* v, ccomm_view_counters* out, size_t size);
+#define ccomm_view_get_counters(v, out) ccomm_view_get_counters_sized((v), (out), sizeof(*(out)))
 
 #ifdef __cplusplus
 }

@@ -7,11 +7,13 @@
 //   auto sp  = client.signal<double>("wheel0_vel_sp");
 //   for (;;) {                                          // real-time loop
 //     pos.write(measured);
-//     ccomm::Reading<double> r = sp.read();             // r.value, r.fresh(), r.info
+//     ccomm::Reading<double> r = sp.read();             // r.value, r.fresh(), r.status
 //   }
 //
 // No exceptions: failures are reported through ok()/error(), as the loop code that
-// uses it is usually built with -fno-exceptions.
+// uses it is usually built with -fno-exceptions. It covers the C API one to one: batch
+// (Client flags, flush()), history (Signal::history()), statistics and introspection
+// (Signal::stats(), Client::describe(), peer_stats()); raw() for anything else.
 #pragma once
 
 #include <array>
@@ -42,12 +44,50 @@ template <typename T>
 struct Reading {
   T value{};
   ccomm_info info{};
-  int code = CCOMM_NEVER;  // ccomm_status (>= 0) or error (< 0)
-  bool fresh() const { return code == CCOMM_FRESH; }
-  bool stale() const { return code == CCOMM_STALE; }
-  bool never() const { return code == CCOMM_NEVER; }
-  bool empty() const { return code == CCOMM_EMPTY; }
-  bool error() const { return code < 0; }
+  int status = CCOMM_NEVER;  // ccomm_status (>= 0) or error (< 0); Reading.status in Python
+  bool fresh() const { return status == CCOMM_FRESH; }
+  bool stale() const { return status == CCOMM_STALE; }
+  bool never() const { return status == CCOMM_NEVER; }
+  bool empty() const { return status == CCOMM_EMPTY; }
+  bool error() const { return status < 0; }
+};
+
+/// One value from a history (see History).
+template <typename T>
+struct HistoryReading {
+  T value{};
+  ccomm_history_info info{};
+  int status = CCOMM_EMPTY;  // CCOMM_FRESH: a value; CCOMM_EMPTY: caught up; < 0: error
+  bool empty() const { return status == CCOMM_EMPTY; }
+  bool error() const { return status < 0; }
+};
+
+/// A reader's cursor over the history of a received state (ccomm_history_*; needs
+/// <node history="N">). Get one with Signal::history(). Real-time safe reads.
+template <typename T>
+class History {
+ public:
+  History() = default;
+  History(ccomm_client* c, ccomm_signal id, uint32_t back) : client_(c), id_(id) {
+    status_ = ccomm_history_start(c, id, back, &cursor_);
+  }
+  /// 0, or why the history could not start (CCOMM_E_NOENT: the node keeps none of it).
+  int status() const { return status_; }
+  /// The next value, or empty() when this reader has caught up.
+  HistoryReading<T> read() {
+    HistoryReading<T> r;
+    r.status = status_ < 0 ? status_ : ccomm_history_read(client_, id_, &cursor_, &r.value, sizeof(T), &r.info);
+    return r;
+  }
+  /// Values this reader missed by falling more than the depth behind.
+  uint64_t overrun() const { return cursor_.overrun; }
+  int depth() const { return ccomm_history_depth(client_, id_); }
+
+ private:
+  ccomm_client* client_ = nullptr;
+  ccomm_signal id_ = CCOMM_E_INVAL;
+  ccomm_history_cursor cursor_{};
+  int status_ = CCOMM_E_INVAL;
 };
 
 /// A typed signal handle. T is a scalar (bool, int32_t, uint32_t, int64_t, float,
@@ -63,11 +103,15 @@ class Signal {
   /// Real-time safe.
   Reading<T> read() const {
     Reading<T> r;
-    r.code = ccomm_read(client_, id_, &r.value, sizeof(T), &r.info);
+    r.status = ccomm_read(client_, id_, &r.value, sizeof(T), &r.info);
     return r;
   }
   /// Real-time safe. Returns 0 or a CCOMM_E_* error.
   int write(const T& v) const { return ccomm_write(client_, id_, &v, sizeof(T)); }
+  /// Every value of this received state from `back` values before the next one on.
+  History<T> history(uint32_t back = 1) const { return History<T>(client_, id_, back); }
+  /// ccommd's counters of this signal on this node; 0 or CCOMM_E_INVAL.
+  int stats(ccomm_signal_stats& out) const { return ccomm_get_signal_stats(client_, id_, &out); }
 
  private:
   ccomm_client* client_ = nullptr;
@@ -91,13 +135,14 @@ class Client {
   }
 
   bool ok() const { return c_ != nullptr; }
+  /// Why the open or the last signal() failed (a CCOMM_E_* code; 0: it did not).
   int error() const { return error_; }
   const char* error_text() const { return ccomm_strerror(error_); }
   ccomm_client* raw() const { return c_; }
   const char* node() const { return ccomm_node_name(c_); }
 
   /// Finds `name` and checks that it is a T. An invalid Signal (valid() == false) if
-  /// not; last_error() says why. Start-up only.
+  /// not; error() says why. Start-up only.
   template <typename T>
   Signal<T> signal(const char* name) {
     using E = typename Element<T>::type;
@@ -108,7 +153,6 @@ class Client {
     if (d.type != TypeCode<E>::value || d.count != Element<T>::count) { error_ = CCOMM_E_TYPE; return Signal<T>(); }
     return Signal<T>(c_, id);
   }
-  int last_error() const { return error_; }
 
   /// Cycle time for this handle's reads and writes (see ccomm_set_time); 0 = per call.
   void set_time(int64_t t_ns) { ccomm_set_time(c_, t_ns); }
@@ -117,6 +161,15 @@ class Client {
   /// Blocks until something changes (non-real-time consumers).
   bool wait(int timeout_ms) { return ccomm_wait(c_, timeout_ms) == 1; }
   bool daemon_alive() const { return ccomm_daemon_alive(c_) == 1; }
+  /// Opened with CCOMM_OPEN_BATCH: hands this step's writes to ccommd at once (call it at
+  /// the end of each cycle); 0 or CCOMM_E_BUSY. Real-time safe.
+  int flush() { return ccomm_flush(c_); }
+
+  /// Introspection (not real-time): the system's signals and nodes, and the counters.
+  int signal_count() const { return ccomm_signal_count(c_); }
+  int describe(ccomm_signal id, ccomm_signal_desc& out) const { return ccomm_describe(c_, id, &out); }
+  int node_count() const { return ccomm_node_count(c_); }
+  int peer_stats(int node, ccomm_peer_stats& out) const { return ccomm_get_peer_stats(c_, node, &out); }
 
  private:
   ccomm_client* c_ = nullptr;

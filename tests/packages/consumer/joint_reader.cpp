@@ -22,13 +22,13 @@ int main(int argc, char** argv) {
   auto pos = c.signal<std::array<double, 6>>("joint_pos");
   auto drive_ok = c.signal<bool>("drive_ok");
   if (!pos.valid() || !drive_ok.valid()) {
-    std::fprintf(stderr, "joint_reader: signals: %s\n", ccomm_strerror(c.last_error()));
+    std::fprintf(stderr, "joint_reader: signals: %s\n", ccomm_strerror(c.error()));
     return 1;
   }
   auto r = pos.read();
   bool ok = r.fresh();
   for (size_t i = 0; i < 6; ++i) ok = ok && r.value[i] == base + double(i);
-  std::printf("joint_reader: joint_pos %s [%g..%g] seq %llu\n", ccomm_strerror(r.code), r.value[0], r.value[5],
+  std::printf("joint_reader: joint_pos %s [%g..%g] seq %llu\n", ccomm_strerror(r.status), r.value[0], r.value[5],
               static_cast<unsigned long long>(r.info.seq));
   int rc = drive_ok.write(true);
   if (rc != 0) std::fprintf(stderr, "joint_reader: write drive_ok: %s\n", ccomm_strerror(rc));

@@ -2,9 +2,9 @@
 """testimage cases for ccomm-image: the daemon is up and a signal makes a round trip
 through the shared-memory store (ccomm pub -> ccomm echo) on the booted target."""
 
+import json
 import re
 import time
-import xml.etree.ElementTree as ET
 
 from oeqa.core.decorator.depends import OETestDepends
 from oeqa.runtime.case import OERuntimeTestCase
@@ -36,15 +36,15 @@ class CcommTest(OERuntimeTestCase):
         self.assertEqual(status, 0, msg='ccommd.service is not enabled: %s' % output)
 
     def _local_double_signal(self):
-        """A double signal this board produces, read from the installed signals.xml."""
+        """A double signal this board produces, from the installed signals.xml as ccommd
+        reads it (ccommd --check --json: the one parser of the file)."""
         status, node = self._run('hostname')
         self.assertEqual(status, 0, msg=node)
-        status, xml = self._run('cat /etc/ccomm/signals.xml')
-        self.assertEqual(status, 0, msg=xml)
-        root = ET.fromstring(xml)
-        for sig in root.iter('signal'):
-            if sig.get('producer') == node and sig.get('type') == 'double':
-                return sig.get('name')
+        status, resolved = self._run('ccommd --check /etc/ccomm/signals.xml --json')
+        self.assertEqual(status, 0, msg=resolved)
+        for sig in json.loads(resolved)['signals']:
+            if sig['producer'] == node and sig['type'] == 'double':
+                return sig['name']
         self.skipTest('/etc/ccomm/signals.xml has no double signal produced by node %r' % node)
 
     @OETestDepends(['ccomm.CcommTest.test_ccommd_active'])

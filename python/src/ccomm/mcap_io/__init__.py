@@ -1,8 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""MCAP recording and replay of ccomm signals (ccomm-record, ccomm-replay).
+"""MCAP recording and replay of ccomm signals (ccomm-record, ccomm-replay). They use the
+ccomm package's binding (ccomm._native, ccomm.Client) like any other program.
 
-capi      the few libccomm calls the recorder's and replayer's loops make, declared for
-          speed (integers and preallocated buffers, no per-call objects)
 schema    what a recording holds: one channel per signal, JSON messages described by a
           JSON Schema, so Foxglove, PlotJuggler and the `mcap` reader need no ccomm
 writer    the writer process: turns captured records into MCAP messages, rotates files,

@@ -14,7 +14,7 @@ from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 
-from .capi import TYPE_FORMATS
+from ..client import TYPE_FORMATS
 from .schema import METADATA_NAME, SCHEMA_ENCODING, SCHEMA_PREFIX, value_struct
 
 RECOVER_HINT = "ccomm-record --recover FILE -o FIXED.mcap keeps every intact chunk"

@@ -30,7 +30,7 @@ import json
 import struct
 from typing import Any, Callable, Dict, Tuple
 
-from .capi import STATUS_NAMES, TYPE_FORMATS, SignalDesc
+from ..client import STATUS_NAMES, TYPE_FORMATS, SignalInfo
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -43,17 +43,14 @@ FORMAT_VERSION = "1"
 RECORD = struct.Struct("<HBBQqQQ")
 FLAG_SAFE_VALUE = 0x1
 
-_JSON_TYPES = {"bool": "boolean", "int32": "integer", "uint32": "integer", "int64": "integer",
-               "float": "number", "double": "number"}
 
-
-def schema_name(desc: SignalDesc) -> str:
+def schema_name(desc: SignalInfo) -> str:
     return SCHEMA_PREFIX + desc.type_text
 
 
-def json_schema(desc: SignalDesc) -> bytes:
+def json_schema(desc: SignalInfo) -> bytes:
     """JSON Schema of one signal's messages (one schema per type and count)."""
-    elem: Dict[str, Any] = {"type": [_JSON_TYPES[desc.type], "null"]}
+    elem: Dict[str, Any] = {"type": [desc.type.json_type, "null"]}
     value: Dict[str, Any] = elem if desc.count == 1 else {"type": "array", "items": elem,
                                           "minItems": desc.count, "maxItems": desc.count}
     integer = {"type": "integer"}
@@ -78,9 +75,9 @@ def json_schema(desc: SignalDesc) -> bytes:
     return json.dumps(schema, indent=1).encode()
 
 
-def channel_metadata(desc: SignalDesc) -> Dict[str, str]:
+def channel_metadata(desc: SignalInfo) -> Dict[str, str]:
     """What replay checks against the node it writes to."""
-    return {"ccomm.signal": desc.name, "ccomm.type": desc.type, "ccomm.count": str(desc.count),
+    return {"ccomm.signal": desc.name, "ccomm.type": desc.type_name, "ccomm.count": str(desc.count),
             "ccomm.event": "1" if desc.is_event else "0", "ccomm.producer": desc.producer,
             "ccomm.format": FORMAT_VERSION}
 
@@ -104,12 +101,12 @@ def _number_text(type_name: str) -> Callable[[object], str]:
 MessageEncoder = Callable[[bytes, int, int, int, int, int, int, int, int], bytes]
 
 
-def message_encoder(desc: SignalDesc) -> Tuple[struct.Struct, MessageEncoder]:
+def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
     """(value struct, MessageEncoder) for one signal: the JSON message as bytes, built
     with one format operation (the writer encodes up to 100 000 of them a second)."""
-    vs = value_struct(desc.type, desc.count)
-    number = _number_text(desc.type)
-    floating = desc.type in ("float", "double")
+    vs = value_struct(desc.type_name, desc.count)
+    number = _number_text(desc.type_name)
+    floating = desc.type_name in ("float", "double")
     head = '{"value":'
     tail = ('"seq":%d,"source_time_ns":%d,"receive_time_ns":%d,"status":"%s",'
             '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d}')

@@ -21,7 +21,7 @@ from typing import IO, Any, Dict, List, Optional
 
 from mcap.writer import CompressionType, Writer
 
-from .capi import SignalDesc
+from ..client import SignalInfo
 from .schema import (FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
                      channel_metadata, json_schema, message_encoder, schema_name)
 
@@ -32,7 +32,7 @@ COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
 @dataclass
 class WriterOptions:
     output: str
-    signals: List[SignalDesc]
+    signals: List[SignalInfo]
     node: str
     compression: str = "lz4"
     chunk_size: int = 1 << 20
@@ -69,7 +69,7 @@ def rotated_name(output: str, index: int) -> str:
 class RecordingWriter:
     def __init__(self, o: WriterOptions) -> None:
         self.o = o
-        self.by_id: Dict[int, SignalDesc] = {d.id: d for d in o.signals}
+        self.by_id: Dict[int, SignalInfo] = {d.id: d for d in o.signals}
         self.encoders = {d.id: message_encoder(d)[1] for d in o.signals}
         self.value_bytes = {d.id: d.value_bytes for d in o.signals}
         self.stats = {d.id: SignalStats() for d in o.signals}

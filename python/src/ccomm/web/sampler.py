@@ -23,14 +23,10 @@ from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
 
-from ..client import Client, Reading, Signal, SignalInfo, SignalType, Status
+from ..client import Client, Reading, Signal, SignalInfo, Status
 
 _STATUS_NAMES = {Status.FRESH: "fresh", Status.STALE: "stale", Status.NEVER: "never"}
 
-_JSON_TYPES: Dict[SignalType, str] = {
-    SignalType.BOOL: "boolean", SignalType.INT32: "integer", SignalType.UINT32: "integer",
-    SignalType.INT64: "integer", SignalType.FLOAT: "number", SignalType.DOUBLE: "number",
-}
 
 
 def topic_of(name: str) -> str:
@@ -40,7 +36,7 @@ def topic_of(name: str) -> str:
 
 def json_schema(info: SignalInfo) -> Dict[str, Any]:
     """JSON schema of the messages of one signal's channel."""
-    value: Dict[str, Any] = {"type": [_JSON_TYPES[info.type], "null"]}
+    value: Dict[str, Any] = {"type": [info.type.json_type, "null"]}
     if info.count != 1:
         value = {"type": "array", "items": value, "minItems": info.count, "maxItems": info.count}
     integer, nullable = {"type": "integer"}, {"type": ["integer", "null"]}

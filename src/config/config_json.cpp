@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "config/config_json.h"
+
+#include <stdio.h>
+
+#include <vector>
+
+namespace ccomm {
+namespace {
+
+void Str(std::string* o, const std::string& s) {
+  *o += '"';
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      *o += '\\';
+      *o += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char b[8];
+      snprintf(b, sizeof b, "\\u%04x", c);
+      *o += b;
+    } else {
+      *o += static_cast<char>(c);
+    }
+  }
+  *o += '"';
+}
+
+void Key(std::string* o, const char* k) {
+  Str(o, k);
+  *o += ':';
+}
+
+void Num(std::string* o, const char* k, unsigned long long v) {
+  Key(o, k);
+  *o += std::to_string(v);
+  *o += ',';
+}
+
+void Text(std::string* o, const char* k, const std::string& v) {
+  Key(o, k);
+  Str(o, v);
+  *o += ',';
+}
+
+void Names(std::string* o, const char* k, const std::vector<std::string>& v) {
+  Key(o, k);
+  *o += '[';
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (i) *o += ',';
+    Str(o, v[i]);
+  }
+  *o += "],";
+}
+
+void Close(std::string* o, char bracket) {
+  if (!o->empty() && o->back() == ',') o->pop_back();
+  *o += bracket;
+}
+
+}  // namespace
+
+std::string ConfigToJson(const SystemConfig& cfg) {
+  std::string o = "{";
+  Num(&o, "format", 1);
+  Text(&o, "path", cfg.path);
+  char hash[16];
+  snprintf(hash, sizeof hash, "%08x", cfg.hash);
+  Text(&o, "hash", hash);  // as ccommd --check and the frames' config hash field show it
+  Key(&o, "network");
+  o += '{';
+  Num(&o, "ethertype", cfg.network.ethertype);
+  Num(&o, "udp_port", cfg.network.udp_port);
+  Num(&o, "heartbeat_ms", cfg.network.heartbeat_ms);
+  Num(&o, "peer_timeout_ms", cfg.network.peer_timeout_ms);
+  Num(&o, "summary_ms", cfg.network.summary_ms);
+  Text(&o, "fanout", cfg.network.fanout == Fanout::kMulticast ? "multicast" : "unicast");
+  Key(&o, "authenticated");
+  o += cfg.network.auth_key_file.empty() ? "false," : "true,";
+  Close(&o, '}');
+  o += ',';
+  Key(&o, "nodes");
+  o += '[';
+  for (size_t n = 0; n < cfg.nodes.size(); ++n) {
+    const NodeConfig& node = cfg.nodes[n];
+    o += '{';
+    Num(&o, "id", n);
+    Text(&o, "name", node.name);
+    Text(&o, "transport", node.transport == TransportKind::kUdp ? "udp" : "raw");
+    Text(&o, "interface", node.interface);
+    Text(&o, "ip", node.ip);
+    Num(&o, "history", node.history);
+    Num(&o, "line", static_cast<unsigned long long>(node.line));
+    Close(&o, '}');
+    o += ',';
+  }
+  Close(&o, ']');
+  o += ',';
+  Key(&o, "signals");
+  o += '[';
+  for (size_t s = 0; s < cfg.signals.size(); ++s) {
+    const SignalConfig& sig = cfg.signals[s];
+    o += '{';
+    Num(&o, "id", s);
+    Text(&o, "name", sig.name);
+    Text(&o, "type", ValueTypeName(sig.type));
+    Num(&o, "count", sig.count);
+    Num(&o, "value_bytes", sig.value_bytes());
+    Text(&o, "kind", sig.kind == SignalKind::kEvent ? "event" : "state");
+    Text(&o, "producer", cfg.nodes[sig.producer].name);
+    std::vector<std::string> consumers;
+    for (uint32_t c : sig.consumers) consumers.push_back(cfg.nodes[c].name);
+    Names(&o, "consumers", consumers);
+    Num(&o, "stale_after_ms", sig.stale_after_ms);
+    Num(&o, "period_us", sig.period_us);
+    Num(&o, "queue_depth", sig.queue_depth);
+    Key(&o, "has_safe_value");
+    o += sig.has_safe_value ? "true," : "false,";
+    Num(&o, "line", static_cast<unsigned long long>(sig.line));
+    Close(&o, '}');
+    o += ',';
+  }
+  Close(&o, ']');
+  o += ',';
+  Key(&o, "ros2");
+  o += '[';
+  for (const Ros2Config& r : cfg.ros2) {
+    o += '{';
+    Text(&o, "node", r.node);
+    Text(&o, "namespace", r.ros_namespace);
+    if (r.has_domain) Num(&o, "domain", r.domain);
+    if (r.publish_given) Names(&o, "publish", r.publish);
+    Names(&o, "subscribe", r.subscribe);
+    Close(&o, '}');
+    o += ',';
+  }
+  Close(&o, ']');
+  o += "}\n";
+  return o;
+}
+
+}  // namespace ccomm

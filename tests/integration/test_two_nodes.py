@@ -33,7 +33,10 @@ def test_setup_simulation_both_ways(transport):
             if SANITIZED:  # slow build: only that every direction works
                 assert r["count"] > 100, r
                 continue
-            assert r["count"] > 1000, r
+            # Judged against what the peer really sent: on a loaded machine a starved sender
+            # sends fewer than 2000 cycles in 2 s (CI-like load 13: 426), which is not a loss.
+            # (received and lost leave out the 0.5 s warm-up, a quarter of the 2 s run)
+            assert r["count"] > 100 and r["received"] + r["lost"] >= 0.9 * 0.75 * sent_by_peer, (r, sent_by_peer)
             # Cycles the app did not see complete: on a loaded 2-core machine a late reader or
             # a late ccommd lets a newer value replace an older one (state semantics); bounded.
             assert r["lost"] <= 0.10 * sent_by_peer, r
@@ -45,7 +48,7 @@ def test_setup_simulation_both_ways(transport):
             assert lost <= (0.1 * ra["sent"] if SANITIZED else 0), (node, lost)
         assert ra["send_signals"] == 36 and rb["send_signals"] == 9
         st = pair.stats("planner")
-        assert signal_stats(st, "wheel0_pos")["rx"] >= (200 if SANITIZED else 1500)
+        assert signal_stats(st, "wheel0_pos")["rx"] >= (200 if SANITIZED else 0.75 * ra["sent"])
         assert peer_stats(st, "control")["alive"]
         assert st["counters"]["frames_bad"] == 0
         # One frame per cycle: control sent 36 doubles per cycle in (about) one frame each.

@@ -3,7 +3,6 @@
 
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <new>
 #include <vector>
@@ -133,7 +132,7 @@ int RunningDaemonOf(const std::string& name) {
   if (existing.Open(name) != 0) return 0;  // none, or another layout: CreateOrAdopt decides
   const store::SegmentHeader* h = existing.header();
   const int pid = h->daemon_pid.load(std::memory_order_acquire);
-  if (pid <= 0 || pid == getpid()) return 0;
+  if (pid <= 0 || pid == static_cast<int>(platform::ProcessId())) return 0;
   const uint64_t first = h->daemon_heartbeat_ns.load(std::memory_order_acquire);
   for (int i = 0; i < 20; ++i) {  // its supervision tick stamps every 10 ms
     platform::SleepNs(5000000);

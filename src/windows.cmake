@@ -50,3 +50,24 @@ if(CCOMM_BUILD_TESTS)
   target_link_libraries(config_errors_test PRIVATE ccomm_config)
   target_compile_definitions(config_errors_test PRIVATE CCOMM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()
+
+# The test stand-in for ccommd.exe (tests/windows/segment_host.cpp).
+if(CCOMM_BUILD_TESTS)
+  add_executable(segment_host ${PROJECT_SOURCE_DIR}/tests/windows/segment_host.cpp)
+  ccomm_core_target(segment_host)
+  target_link_libraries(segment_host PRIVATE ccomm_segment_builder)
+endif()
+
+# find_package(ccomm) for the zip (cmake/ccommConfigWindows.cmake.in).
+include(CMakePackageConfigHelpers)
+set(CCOMM_CONFIG_INCLUDEDIR include)
+set(CCOMM_CONFIG_LIBDIR lib)
+set(CCOMM_CONFIG_BINDIR bin)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ccommConfigWindows.cmake.in
+  ${CMAKE_BINARY_DIR}/cmake/ccommConfig.cmake INSTALL_DESTINATION lib/cmake/ccomm
+  PATH_VARS CCOMM_CONFIG_INCLUDEDIR CCOMM_CONFIG_LIBDIR CCOMM_CONFIG_BINDIR)
+write_basic_package_version_file(${CMAKE_BINARY_DIR}/cmake/ccommConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_BINARY_DIR}/cmake/ccommConfig.cmake ${CMAKE_BINARY_DIR}/cmake/ccommConfigVersion.cmake
+        DESTINATION lib/cmake/ccomm)
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION .)

@@ -16,3 +16,17 @@ if(CCOMM_BUILD_TESTS)
   enable_testing()
 endif()
 add_subdirectory(src)
+
+# The Simulink S-functions compiled for Windows as MATLAB would (the MEX build and the
+# build for generated code) against the stand-in simstruc.h in integrations/simulink/harness
+# (integrations/CMakeLists.txt has the same for Linux, where the harness also runs them).
+# Only the compile is checked here; linking a MEX against libmex and running it in
+# Simulink needs MATLAB.
+set(_sl ${PROJECT_SOURCE_DIR}/integrations/simulink)
+add_library(ccomm_sfun_mex OBJECT ${_sl}/sfun_ccomm_read.c ${_sl}/sfun_ccomm_write.c ${_sl}/ccomm_blk.c)
+target_compile_definitions(ccomm_sfun_mex PRIVATE MATLAB_MEX_FILE)
+add_library(ccomm_sfun_cg OBJECT ${_sl}/sfun_ccomm_read.c ${_sl}/sfun_ccomm_write.c)
+foreach(t ccomm_sfun_mex ccomm_sfun_cg)
+  target_include_directories(${t} PRIVATE ${_sl}/harness ${_sl} ${PROJECT_SOURCE_DIR}/src/include)
+  set_target_properties(${t} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+endforeach()

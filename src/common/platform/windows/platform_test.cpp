@@ -76,13 +76,19 @@ TEST(WindowsFutex, AWakeThroughOneMappingReachesAWaiterOnAnother) {
   pf::FutexPrepare(wb);
 
   EXPECT_FALSE(pf::FutexWait(wb, 0, 20000000)) << "nothing changed: times out";
+  // A waiter that missed the wake would return only at its 20 s timeout, seeing the
+  // word changed by then: woken means back well before that.
+  constexpr uint64_t kTimeoutNs = 20000000000ull, kWokenWithinNs = 5000000000ull;
   std::atomic<int> woken{0};
+  std::atomic<uint64_t> wake_ns{0};
   std::thread waiters[3];
   for (auto& t : waiters)
     t = std::thread([&] {
-      if (pf::FutexWait(wb, 0, 10000000000ll)) woken.fetch_add(1);
+      if (pf::FutexWait(wb, 0, static_cast<int64_t>(kTimeoutNs)) && pf::MonotonicNs() - wake_ns.load() < kWokenWithinNs)
+        woken.fetch_add(1);
     });
   pf::SleepNs(20000000);
+  wake_ns.store(pf::MonotonicNs());
   wa->store(1);
   pf::FutexWake(wa, 1 << 30);
   for (auto& t : waiters) t.join();

@@ -3,12 +3,12 @@
 // read-only, through the seqlock of each node record. Names come from the client's
 // segment through the public API.
 #include <errno.h>
-#include <time.h>
 
 #include <new>
 
 #include "ccomm/ccomm.h"
 #include "client/sized_struct.h"
+#include "common/platform.h"
 #include "store/view.h"
 
 struct ccomm_view {
@@ -30,15 +30,14 @@ const char* NodeName(const ccomm_view* v, int node) {
 // as ccommd is descheduled mid-rewrite (a time slice, a VM stall), so this monitoring
 // API waits it out here, bounded, instead of handing every caller a retry loop.
 constexpr int kBusyWaits = 100;
-constexpr long kBusyWaitNs = 500000;  // 100 x 0.5 ms: at most ~50 ms
+constexpr uint64_t kBusyWaitNs = 500000;  // 100 x 0.5 ms: at most ~50 ms
 
 template <typename Read>
 bool ReadPatiently(Read read) {
   for (int i = 0;; ++i) {
     if (read()) return true;
     if (i == kBusyWaits) return false;
-    const struct timespec pause = {0, kBusyWaitNs};
-    nanosleep(&pause, nullptr);
+    ccomm::platform::SleepNs(kBusyWaitNs);
   }
 }
 

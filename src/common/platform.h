@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // The platform layer (zenoh-pico style): every OS call of the store, the client library
 // and ccommd's threads (clock, futex, shared memory, scheduling, sleeping, logging) goes
-// through this header, so a port (Xenomai, another RTOS) of what runs inside the
-// applications touches one file. The daemon's Linux-only services have a file each that
+// through this header. It has one unit per platform, whole files chosen by CMake
+// (src/common/CMakeLists.txt), never #ifdefs inside functions:
+//   platform/posix/platform.cpp    Linux (glibc; Xenomai's POSIX skin wraps it)
+//   platform/windows/platform.cpp  Windows x64 (named file mappings, named events)
+// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's Linux-only services have a file each that
 // is their platform layer: transport_raw.cpp / transport_udp.cpp (sockets),
 // privileges.cpp (capabilities, prctl), auth.cpp (the key file), config.cpp (reading
 // signals.xml). Functions marked [rt] are safe on a real-time path: no allocation, no
@@ -12,6 +15,20 @@
 #include <cstddef>
 #include <cstdint>
 #include <atomic>
+#include <string>
+#if defined(_MSC_VER)
+#include <intrin.h>  // _mm_pause
+#endif
+
+// printf-style checking where the compiler has it (GCC, Clang; MinGW's printf is the
+// C99 one, __USE_MINGW_ANSI_STDIO), nothing for MSVC.
+#if defined(__MINGW32__)
+#define CCOMM_PRINTF_FORMAT(f, a) __attribute__((format(gnu_printf, f, a)))
+#elif defined(__GNUC__)
+#define CCOMM_PRINTF_FORMAT(f, a) __attribute__((format(printf, f, a)))
+#else
+#define CCOMM_PRINTF_FORMAT(f, a)
+#endif
 
 namespace ccomm {
 namespace platform {
@@ -21,7 +38,9 @@ uint64_t MonotonicNs();
 
 /// [rt] Hint to the CPU inside a spin loop.
 inline void CpuRelax() {
-#if defined(__x86_64__) || defined(__i386__)
+#if defined(_MSC_VER) && (defined(_M_X64) || defined(_M_IX86))
+  _mm_pause();
+#elif defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
 #elif defined(__aarch64__) || (defined(__arm__) && (__ARM_ARCH >= 7))
   __asm__ __volatile__("yield");
@@ -32,22 +51,46 @@ inline void CpuRelax() {
 void FutexWake(std::atomic<uint32_t>* word, int n);
 /// Blocks while *word == expected, at most timeout_ns (<0 = forever). Returns false on timeout.
 bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_ns);
+/// Readies `word` (in memory from MapShared) for FutexWake/FutexWait before the real-time
+/// path uses it: nothing on Linux; on Windows it opens the word's named event, so that
+/// no wake or wait creates one. Not [rt]: called when a segment is opened.
+void FutexPrepare(std::atomic<uint32_t>* word);
 
 /// [rt] This process's pid, cached (refreshed after fork); no syscall.
 uint32_t ProcessId();
 /// False only if no process `pid` exists (kill(pid, 0) == ESRCH). Not [rt].
 bool ProcessAlive(uint32_t pid);
 
-/// Shared memory. Names are POSIX shm names ("/ccomm.node").
+/// Shared memory. Names are POSIX shm names ("/ccomm.node"); the Windows unit makes them
+/// named file mappings ("Local\\ccomm.node", see docs/install.md).
 int ShmOpen(const char* name, bool create_exclusive, int mode);  // fd or -errno
+int ShmOpenReadOnly(const char* name);                             // fd or -errno
 int ShmUnlink(const char* name);                                   // 0 or -errno
 void* MapShared(int fd, size_t size);                              // nullptr on error (errno set)
+const void* MapSharedReadOnly(int fd, size_t size);                // nullptr on error (errno set)
+/// Gives an object made by ShmOpen to group `gid` (its members may map it); 0 or -errno.
+int ShmSetGroup(int fd, int gid);
 void Unmap(void* p, size_t size);
 int FileSize(int fd, size_t* size);                                // 0 or -errno
 /// Sizes a new shm object and allocates its backing (posix_fallocate): a /dev/shm too
 /// small fails here with -ENOSPC instead of a SIGBUS at the first touch. 0 or -errno.
 int Truncate(int fd, size_t size);
 void CloseFd(int fd);
+
+/// Start-up checks of room for a segment (ccommd: segment_builder.cpp). UINT64_MAX means
+/// "no limit known". ShmRoom: free bytes where shm objects live (/dev/shm);
+/// CgroupMemoryRoom: left under memory.max of this process's cgroup and its ancestors;
+/// AddressSpaceRoom: left under RLIMIT_AS.
+uint64_t ShmRoom();
+uint64_t CgroupMemoryRoom();
+uint64_t AddressSpaceRoom();
+/// An exclusive lock on the object `name` (an shm name) that this process holds until it
+/// exits or dies, also while it is stopped (a SIGSTOPped ccommd keeps its node). Returns a
+/// handle to keep (>= 0), -EBUSY (the holder's pid in *holder_pid when known, else 0), or
+/// -errno. `gid` >= 0 gives the object to that group.
+int LockExclusive(const char* name, int gid, int* holder_pid);
+/// Gives up a lock LockExclusive returned.
+void UnlockExclusive(int handle);
 
 /// Locks current and future memory; returns 0 or -errno.
 int LockAllMemory();
@@ -66,6 +109,12 @@ void PrefaultStack(size_t bytes);
 /// POSIX shm objects whose names start with `prefix` (without the leading '/'): how many,
 /// and the rest of the first one's name in `first` (`cap` bytes). Start-up only.
 int ListShm(const char* prefix, char* first, size_t cap);
+/// Reads the regular file `path` whole into `text` (start-up only). 0, -EINVAL if it is
+/// not a regular file, -EFBIG if larger than `max_bytes` (its size in `size`), -EIO if
+/// a read failed (errno says why), or the -errno of opening it.
+int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uint64_t* size);
+/// True if `name` matches the shell glob `pattern` (* ? [...], as fnmatch with no flags).
+bool GlobMatch(const char* pattern, const char* name);
 /// Hostname (for the default node name); false on error.
 bool HostName(char* buf, size_t cap);
 
@@ -74,7 +123,7 @@ bool HostName(char* buf, size_t cap);
 /// Logging for start-up, shutdown and rare events; never used per message. Lines go to
 /// stderr with sd-daemon priority prefixes ("<3>"), which journald understands.
 enum class LogLevel { kError = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
-void Log(LogLevel level, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void Log(LogLevel level, const char* fmt, ...) CCOMM_PRINTF_FORMAT(2, 3);
 void SetLogVerbosity(LogLevel max_level);
 void SetLogPrefixes(bool sd_prefixes);
 

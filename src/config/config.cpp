@@ -11,14 +11,12 @@
 
 #include "config/config.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
 
+#include "common/platform.h"
 #include "config/parser.h"
 
 namespace ccomm {
@@ -140,34 +138,14 @@ bool LoadConfig(const std::string& path, SystemConfig* out, std::string* error) 
     if (error) *error = path + ": error: " + what;
     return false;
   };
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return fail(std::string("cannot open: ") + std::strerror(errno));
-  struct stat st;
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    return fail("not a regular file");
-  }
-  if (static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
-    ::close(fd);
-    return fail("file is " + std::to_string(st.st_size) + " bytes; at most " +
-                std::to_string(kMaxFileBytes) + " accepted");
-  }
   std::string text;
-  text.resize(static_cast<size_t>(st.st_size));
-  size_t got = 0;
-  while (got < text.size()) {
-    ssize_t n = ::read(fd, &text[got], text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      int e = errno;
-      ::close(fd);
-      return fail(std::string("read failed: ") + std::strerror(e));
-    }
-    if (n == 0) break;  // file shrank while reading
-    got += static_cast<size_t>(n);
-  }
-  ::close(fd);
-  text.resize(got);
+  uint64_t size = 0;
+  const int r = platform::ReadRegularFile(path.c_str(), kMaxFileBytes, &text, &size);
+  if (r == -EINVAL) return fail("not a regular file");
+  if (r == -EFBIG)
+    return fail("file is " + std::to_string(size) + " bytes; at most " + std::to_string(kMaxFileBytes) + " accepted");
+  if (r == -EIO) return fail(std::string("read failed: ") + std::strerror(errno));
+  if (r != 0) return fail(std::string("cannot open: ") + std::strerror(-r));
   return ParseConfig(text, path, out, error);
 }
 

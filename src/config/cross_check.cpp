@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Checks across elements: unique names and addresses, producers and consumers that
 // exist, transports that match.
-#include <fnmatch.h>
 
 #include <algorithm>
 #include <cstring>
 
+#include "common/platform.h"
 #include "config/parser.h"
 
 namespace ccomm {
@@ -113,7 +113,7 @@ void Parser::CrossCheck(SystemConfig* cfg) {
       if (mn.monitor.empty() || static_cast<int>(m) == producer || producer < 0) continue;
       if (std::find(s.consumers.begin(), s.consumers.end(), m) != s.consumers.end()) continue;
       const bool match = std::any_of(mn.monitor.begin(), mn.monitor.end(), [&](const std::string& p) {
-        return fnmatch(p.c_str(), s.name.c_str(), 0) == 0;
+        return platform::GlobMatch(p.c_str(), s.name.c_str());
       });
       if (!match) continue;
       s.consumers.push_back(m);

@@ -177,7 +177,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   uint64_t now = platform::MonotonicNs();
   for (uint32_t id : periodic_) due_ns_[id] = now;
   store::SegmentHeader* h = segment_.header();
-  h->daemon_pid.store(static_cast<int32_t>(getpid()), std::memory_order_release);
+  h->daemon_pid.store(static_cast<int32_t>(platform::ProcessId()), std::memory_order_release);
   h->daemon_heartbeat_ns.store(now, std::memory_order_release);
   running_.store(true);
   return 0;
@@ -258,7 +258,7 @@ void Daemon::Shutdown() {
     segment_.header()->daemon_pid.store(0, std::memory_order_release);
     segment_.Close();  // the segment stays: clients keep reading (stale) values
   }
-  platform::CloseFd(lock_fd_);  // the next ccommd of this node may start
+  platform::UnlockExclusive(lock_fd_);  // the next ccommd of this node may start
   lock_fd_ = -1;
 }
 

@@ -2,14 +2,8 @@
 #include "daemon/segment_builder.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/resource.h>
-#include <sys/stat.h>
-#include <sys/statvfs.h>
-#include <unistd.h>
 
 #include <stdint.h>
 
@@ -153,47 +147,6 @@ std::string HumanBytes(uint64_t b) {
   return buf;
 }
 
-// The smallest room left under memory.max of this process's cgroup and its ancestors
-// (cgroup v2), or UINT64_MAX when none sets a limit (or there is no cgroup v2).
-uint64_t CgroupMemoryRoom() {
-  uint64_t room = UINT64_MAX;
-  FILE* f = fopen("/proc/self/cgroup", "r");
-  if (!f) return room;
-  char line[512], path[512] = "";
-  while (fgets(line, sizeof line, f))
-    if (strncmp(line, "0::", 3) == 0) snprintf(path, sizeof path, "%s", line + 3);
-  fclose(f);
-  path[strcspn(path, "\n")] = '\0';
-  std::string dir = path;
-  for (;;) {
-    unsigned long long max = 0, current = 0;
-    const std::string base = "/sys/fs/cgroup" + dir;
-    FILE* m = fopen((base + "/memory.max").c_str(), "r");
-    FILE* c = fopen((base + "/memory.current").c_str(), "r");
-    if (m && c && fscanf(m, "%llu", &max) == 1 && fscanf(c, "%llu", &current) == 1)
-      room = std::min<uint64_t>(room, max > current ? max - current : 0);
-    if (m) fclose(m);
-    if (c) fclose(c);
-    const size_t slash = dir.rfind('/');
-    if (dir.empty() || slash == std::string::npos) break;
-    dir.resize(slash);
-  }
-  return room;
-}
-
-// Address space left under RLIMIT_AS, or UINT64_MAX without a limit.
-uint64_t AddressSpaceRoom() {
-  struct rlimit rl;
-  if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY) return UINT64_MAX;
-  unsigned long long pages = 0;
-  if (FILE* f = fopen("/proc/self/statm", "r")) {
-    if (fscanf(f, "%llu", &pages) != 1) pages = 0;
-    fclose(f);
-  }
-  const uint64_t used = pages * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
-  return rl.rlim_cur > used ? rl.rlim_cur - used : 0;
-}
-
 }  // namespace
 
 std::string SegmentFitProblem(const SystemConfig& cfg, uint32_t node_id, const std::string& name) {
@@ -213,26 +166,23 @@ std::string SegmentFitProblem(const SystemConfig& cfg, uint32_t node_id, const s
   if (p.total > SIZE_MAX / 2) return need + ", more than this system can map" + fix + "split the signals";
   // Re-adopting an existing segment of this size needs no new room in /dev/shm.
   bool adopt = false;
-  int fd = shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
+  int fd = platform::ShmOpenReadOnly(name.c_str());
   if (fd >= 0) {
-    struct stat st;
-    adopt = fstat(fd, &st) == 0 && static_cast<uint64_t>(st.st_size) == p.total;
-    close(fd);
+    size_t size = 0;
+    adopt = platform::FileSize(fd, &size) == 0 && size == p.total;
+    platform::CloseFd(fd);
   }
-  struct statvfs vfs;
-  if (!adopt && statvfs("/dev/shm", &vfs) == 0) {
-    const uint64_t free_bytes = uint64_t{vfs.f_bavail} * vfs.f_frsize;
-    if (p.total > free_bytes)
-      return need + ", but /dev/shm has " + HumanBytes(free_bytes) + " free" + fix +
-             "enlarge /dev/shm (mount -o remount,size=...)";
-  }
+  const uint64_t free_bytes = adopt ? UINT64_MAX : platform::ShmRoom();
+  if (p.total > free_bytes)
+    return need + ", but /dev/shm has " + HumanBytes(free_bytes) + " free" + fix +
+           "enlarge /dev/shm (mount -o remount,size=...)";
   // ccommd holds the segment and, while it builds it, an image of the same size.
   const uint64_t memory = 2 * uint64_t{p.total};
-  const uint64_t cgroup = CgroupMemoryRoom();
+  const uint64_t cgroup = platform::CgroupMemoryRoom();
   if (memory > cgroup)
     return need + " (twice that while starting), but the memory limit (cgroup memory.max) leaves " +
            HumanBytes(cgroup) + fix + "raise MemoryMax";
-  const uint64_t as = AddressSpaceRoom();
+  const uint64_t as = platform::AddressSpaceRoom();
   if (memory > as)
     return need + " (twice that while starting), but RLIMIT_AS leaves " + HumanBytes(as) + fix +
            "raise LimitAS";
@@ -240,32 +190,7 @@ std::string SegmentFitProblem(const SystemConfig& cfg, uint32_t node_id, const s
 }
 
 int LockNode(const std::string& segment_name, int gid, int* holder_pid) {
-  *holder_pid = 0;
-  const std::string name = segment_name + ".lock";
-  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0660);
-  if (fd < 0) return -errno;
-  // The first ccommd creates it: umask must not narrow it, and the group shares it.
-  struct stat st;
-  if (fstat(fd, &st) == 0 && st.st_uid == geteuid()) {
-    if (fchmod(fd, 0660) != 0) { /* best effort: the lock works without */ }
-    if (gid >= 0 && fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) != 0) { /* idem */ }
-  }
-  struct flock lk;
-  memset(&lk, 0, sizeof lk);
-  lk.l_type = F_WRLCK;
-  lk.l_whence = SEEK_SET;
-  if (fcntl(fd, F_SETLK, &lk) == 0) return fd;
-  const int e = errno;
-  if (e == EAGAIN || e == EACCES) {
-    memset(&lk, 0, sizeof lk);
-    lk.l_type = F_WRLCK;
-    lk.l_whence = SEEK_SET;
-    if (fcntl(fd, F_GETLK, &lk) == 0 && lk.l_type != F_UNLCK) *holder_pid = lk.l_pid;
-    close(fd);
-    return -EBUSY;
-  }
-  close(fd);
-  return -e;
+  return platform::LockExclusive((segment_name + ".lock").c_str(), gid, holder_pid);
 }
 
 int CreateOrAdoptSegment(store::Segment* segment, const SystemConfig& cfg, uint32_t node_id,

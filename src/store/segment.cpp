@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <new>
 
@@ -127,6 +126,8 @@ int Segment::Open(const std::string& name) {
   }
   base_ = p;
   size_ = size;
+  platform::FutexPrepare(&header()->tx_doorbell);  // the doorbells' set-up, before any write
+  platform::FutexPrepare(&header()->rx_doorbell);
   if (CopyLayout(p) != 0) {
     Close();
     return -ENOMEM;
@@ -271,8 +272,8 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
     *error = "cannot create shared memory " + name + ": " + strerror(-fd);
     return fd;
   }
-  if (gid >= 0 && fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) != 0)
-    Log(LogLevel::kWarning, "cannot give %s to group %d: %s", name.c_str(), gid, strerror(errno));
+  if (gid >= 0 && (r = platform::ShmSetGroup(fd, gid)) != 0)
+    Log(LogLevel::kWarning, "cannot give %s to group %d: %s", name.c_str(), gid, strerror(-r));
   r = platform::Truncate(fd, size);
   void* p = r == 0 ? platform::MapShared(fd, size) : nullptr;
   if (r == 0 && !p) r = -errno;
@@ -285,6 +286,8 @@ int Segment::CreateOrAdopt(const void* plan, size_t size, const std::string& nam
   memcpy(p, plan, size);
   base_ = p;
   size_ = size;
+  platform::FutexPrepare(&header()->tx_doorbell);  // the doorbells' set-up, before any write
+  platform::FutexPrepare(&header()->rx_doorbell);
   if (CopyLayout(plan) != 0) {
     Close();
     platform::ShmUnlink(name.c_str());

@@ -3,11 +3,7 @@
 #include "store/view.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <cstdlib>
 
@@ -47,7 +43,7 @@ int View::Create(const std::string& name, uint32_t nodes, uint32_t signals, uint
       *error += " (left by a ccommd of another user? remove /dev/shm" + name + ")";
     return fd;
   }
-  if (gid >= 0 && fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) != 0) {
+  if (gid >= 0 && platform::ShmSetGroup(fd, gid) != 0) {
     // Not fatal: members of the group just cannot read the view.
   }
   int r = platform::Truncate(fd, size);
@@ -78,18 +74,15 @@ int View::Create(const std::string& name, uint32_t nodes, uint32_t signals, uint
 
 int View::OpenReadOnly(const std::string& name) {
   Close();
-  int fd = shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
-  if (fd < 0) return -errno;
+  int fd = platform::ShmOpenReadOnly(name.c_str());
+  if (fd < 0) return fd;
   size_t size = 0;
   int r = platform::FileSize(fd, &size);
   if (r == 0 && size < sizeof(ViewHeader)) r = -EPROTO;
-  void* p = nullptr;
+  const void* p = nullptr;
   if (r == 0) {
-    p = mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
-    if (p == MAP_FAILED) {
-      p = nullptr;
-      r = -errno;
-    }
+    p = platform::MapSharedReadOnly(fd, size);
+    if (!p) r = -errno;
   }
   platform::CloseFd(fd);
   if (r != 0) return r;
@@ -97,10 +90,10 @@ int View::OpenReadOnly(const std::string& name) {
   if (h->state.load(std::memory_order_acquire) != kViewReady || h->magic != kViewMagic ||
       h->version != kViewVersion || h->size != size || SizeFor(h->node_count, h->signal_count) != size ||
       h->self >= h->node_count) {
-    munmap(p, size);
+    platform::Unmap(const_cast<void*>(p), size);
     return -EPROTO;
   }
-  base_ = p;
+  base_ = const_cast<void*>(p);
   size_ = size;
   return 0;
 }
@@ -112,7 +105,7 @@ void View::Remove() {
 }
 
 void View::Close() {
-  if (base_) munmap(base_, size_);
+  platform::Unmap(base_, size_);
   base_ = nullptr;
   size_ = 0;
 }

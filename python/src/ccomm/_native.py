@@ -14,7 +14,9 @@ import struct
 from pathlib import Path
 from typing import Any, Dict, Mapping, Optional, Sequence, Type
 
-LIB_NAMES = ("libccomm.so.0", "libccomm.so")
+# Windows: ccomm.dll in bin/ of a build or of the zip (docs/install.md "Windows").
+LIB_NAMES = ("ccomm.dll",) if os.name == "nt" else ("libccomm.so.0", "libccomm.so")
+LIB_SUBDIR = "bin" if os.name == "nt" else "lib"
 OPEN_NO_DOORBELL = 0x1  # CCOMM_OPEN_NO_DOORBELL
 OPEN_BATCH = 0x2  # CCOMM_OPEN_BATCH: writes leave together at ccomm_flush()
 
@@ -170,7 +172,7 @@ def _repo_roots(starts: Sequence[Path]) -> list[Path]:
 
 
 # Where a binary wheel carries its libccomm (scripts/package puts it there).
-BUNDLED = Path(__file__).resolve().parent / "_lib" / "libccomm.so.0"
+BUNDLED = Path(__file__).resolve().parent / "_lib" / LIB_NAMES[0]
 
 
 def candidates(env: Mapping[str, str], starts: Sequence[Path],
@@ -183,10 +185,10 @@ def candidates(env: Mapping[str, str], starts: Sequence[Path],
         return [Path(env["CCOMM_LIBRARY"])]
     out.append(BUNDLED if bundled is None else bundled)
     if env.get("CCOMM_BUILD_DIR"):
-        out += [Path(env["CCOMM_BUILD_DIR"]) / "lib" / n for n in LIB_NAMES]
+        out += [Path(env["CCOMM_BUILD_DIR"]) / LIB_SUBDIR / n for n in LIB_NAMES]
     builds: list[Path] = []
     for root in _repo_roots(starts):
-        for b in root.glob("build*/lib"):
+        for b in root.glob(f"build*/{LIB_SUBDIR}"):
             if any((b / n).is_file() for n in LIB_NAMES):
                 builds.append(b)
     builds.sort(key=lambda b: max((b / n).stat().st_mtime for n in LIB_NAMES if (b / n).is_file()),

@@ -31,7 +31,11 @@ extern "C" {
 
 #define CCOMM_API_VERSION 1
 
-#if defined(__GNUC__)
+#if defined(_WIN32) && defined(CCOMM_BUILDING_DLL)
+#define CCOMM_API __declspec(dllexport)
+#elif defined(_WIN32)
+#define CCOMM_API __declspec(dllimport)
+#elif defined(__GNUC__)
 #define CCOMM_API __attribute__((visibility("default")))
 #else
 #define CCOMM_API

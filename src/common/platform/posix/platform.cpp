@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: Apache-2.0
+// The platform layer's POSIX unit (Linux, glibc; see common/platform.h).
 #include "common/platform.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <fnmatch.h>
 #include <linux/futex.h>
 #include <linux/sock_diag.h>
 #include <pthread.h>
 #include <sched.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -47,6 +48,8 @@ bool FutexWait(std::atomic<uint32_t>* word, uint32_t expected, int64_t timeout_n
   return !(r != 0 && errno == ETIMEDOUT);
 }
 
+void FutexPrepare(std::atomic<uint32_t>*) {}  // a futex needs no set-up
+
 namespace {
 std::atomic<uint32_t> g_pid{0};
 void ResetPid() { g_pid.store(static_cast<uint32_t>(getpid()), std::memory_order_relaxed); }
@@ -76,10 +79,24 @@ int ShmOpen(const char* name, bool create_exclusive, int mode) {
   return fd;
 }
 
+int ShmOpenReadOnly(const char* name) {
+  int fd = shm_open(name, O_RDONLY | O_CLOEXEC, 0);
+  return fd < 0 ? -errno : fd;
+}
+
+int ShmSetGroup(int fd, int gid) {
+  return fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) == 0 ? 0 : -errno;
+}
+
 int ShmUnlink(const char* name) { return shm_unlink(name) == 0 ? 0 : -errno; }
 
 void* MapShared(int fd, size_t size) {
   void* p = mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  return p == MAP_FAILED ? nullptr : p;
+}
+
+const void* MapSharedReadOnly(int fd, size_t size) {
+  void* p = mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
   return p == MAP_FAILED ? nullptr : p;
 }
 
@@ -129,11 +146,39 @@ int SocketDrops(int fd, uint32_t* drops) {
   return 0;
 }
 
-void PrefaultStack(size_t bytes) {
-  volatile unsigned char buf[64 * 1024];
-  size_t n = bytes < sizeof buf ? bytes : sizeof buf;
-  for (size_t i = 0; i < n; i += 4096) buf[i] = 0;
+int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uint64_t* size) {
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return -errno;
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    close(fd);
+    return -EINVAL;
+  }
+  *size = static_cast<uint64_t>(st.st_size);
+  if (*size > max_bytes) {
+    close(fd);
+    return -EFBIG;
+  }
+  text->resize(static_cast<size_t>(st.st_size));
+  size_t got = 0;
+  while (got < text->size()) {
+    ssize_t n = read(fd, &(*text)[got], text->size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      int e = errno;
+      close(fd);
+      errno = e;
+      return -EIO;
+    }
+    if (n == 0) break;  // file shrank while reading
+    got += static_cast<size_t>(n);
+  }
+  close(fd);
+  text->resize(got);
+  return 0;
 }
+
+bool GlobMatch(const char* pattern, const char* name) { return fnmatch(pattern, name, 0) == 0; }
 
 bool HostName(char* buf, size_t cap) {
   if (gethostname(buf, cap) != 0) return false;
@@ -163,23 +208,5 @@ int ListShm(const char* prefix, char* first, size_t cap) {
 }
 
 }  // namespace platform
-
-static LogLevel g_max_level = LogLevel::kInfo;
-static bool g_sd_prefixes = false;
-
-void SetLogVerbosity(LogLevel max_level) { g_max_level = max_level; }
-void SetLogPrefixes(bool sd_prefixes) { g_sd_prefixes = sd_prefixes; }
-
-void Log(LogLevel level, const char* fmt, ...) {
-  if (static_cast<int>(level) > static_cast<int>(g_max_level)) return;
-  char line[1024];
-  int off = 0;
-  if (g_sd_prefixes) off = snprintf(line, sizeof line, "<%d>", static_cast<int>(level));
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
-  va_end(ap);
-  fprintf(stderr, "%s\n", line);
-}
 
 }  // namespace ccomm

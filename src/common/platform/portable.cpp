@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: Apache-2.0
+// The part of the platform layer (common/platform.h) that is plain standard C++ and so
+// the same for every platform unit: logging and stack prefaulting.
+#include <stdarg.h>
+#include <stdio.h>
+
+#include "common/platform.h"
+
+namespace ccomm {
+namespace platform {
+
+void PrefaultStack(size_t bytes) {
+  volatile unsigned char buf[64 * 1024];
+  size_t n = bytes < sizeof buf ? bytes : sizeof buf;
+  for (size_t i = 0; i < n; i += 4096) buf[i] = 0;
+}
+
+}  // namespace platform
+
+static LogLevel g_max_level = LogLevel::kInfo;
+static bool g_sd_prefixes = false;
+
+void SetLogVerbosity(LogLevel max_level) { g_max_level = max_level; }
+void SetLogPrefixes(bool sd_prefixes) { g_sd_prefixes = sd_prefixes; }
+
+void Log(LogLevel level, const char* fmt, ...) {
+  if (static_cast<int>(level) > static_cast<int>(g_max_level)) return;
+  char line[1024];
+  int off = 0;
+  if (g_sd_prefixes) off = snprintf(line, sizeof line, "<%d>", static_cast<int>(level));
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
+  va_end(ap);
+  fprintf(stderr, "%s\n", line);
+}
+
+}  // namespace ccomm

@@ -29,7 +29,7 @@ from typing import Any, Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
 from .mcap_io.capi import E_CORRUPT, HISTORY_INFO_FORMAT, INFO_FORMAT, CcommCallError, Handle, SignalDesc
-from .mcap_io.schema import RECORD
+from .mcap_io.schema import FLAG_INITIAL, RECORD, WATERMARK_ID
 
 EXAMPLES = """\
 examples:
@@ -181,6 +181,7 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
               ctypes.addressof(cur) if cur is not None else 0)
              for i, (d, b, cur) in enumerate(zip(sigs, bufs, cursors))]
     last_seq = [0] * len(sigs)
+    first = [True] * len(sigs)  # no value of the signal read yet
     # History-read signals: the cursor's overrun at the previous value, and the values lost
     # before reaching this node so far. A jump in seq is either values the cursor fell too
     # far behind for (its overrun grew: the recorder missed them, the `gap` says so) or
@@ -221,7 +222,8 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
                     elif seq > prev + 1:
                         lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
                     last_seq[i], last_overrun[i] = seq, overrun
-                    out += pack(sid, 0, 0, seq, recv, src, lost_so_far[i])
+                    out += pack(sid, 0, FLAG_INITIAL if prev == 0 and recv < start else 0, seq, recv, src,
+                                lost_so_far[i])
                     out += view
                 continue
             while True:
@@ -238,11 +240,17 @@ def capture(h: Handle, sigs: List[SignalDesc], cursors: List[Any], fd: int, dura
                         delay.max_ns = age
                     if age >= 1_000_000:
                         delay.over_1ms += 1
+                    if not event and first[i]:  # a state's value already there at the start
+                        first[i] = False
+                        if t - age < start:
+                            flags |= FLAG_INITIAL
                     out += pack(sid, status, flags, seq, t - age, src, lost)
                     out += view
                 if not event:
                     break
         if len(out) >= 65536 or ((out or pending) and t - last_send >= 20_000_000):
+            # every value received up to t has now been read: the writer may write those
+            out += pack(WATERMARK_ID, 0, 0, 0, t, 0, 0)
             pending += out
             out.clear()
             _write_some(fd, pending)

@@ -110,6 +110,7 @@ def load(path: str, wanted: Optional[Callable[[str], bool]] = None) -> Recording
     packers: Dict[int, Callable[[object], bytes]] = {}
     signals: Dict[str, RecordedSignal] = {}
     node, messages, complete = "", 0, False
+    start_mono: Optional[int] = None
     it = _records(path)
     while True:
         try:
@@ -141,13 +142,20 @@ def load(path: str, wanted: Optional[Callable[[str], bool]] = None) -> Recording
             sig = wanted_sig
             try:
                 m = json.loads(rec.data)
-                sig.values.append((int(m["source_time_ns"]), int(m["seq"]),
-                                   packers[rec.channel_id](m["value"])))
+                t = int(m["source_time_ns"])
+                if m.get("initial") and start_mono is not None:
+                    # already there at the start: replayed at the start, not after its old gap
+                    t = max(t, start_mono)
+                sig.values.append((t, int(m["seq"]), packers[rec.channel_id](m["value"])))
             except (ValueError, KeyError, TypeError, struct.error) as e:
                 raise RecordingError(f"{path}: message {messages} ({sig.name}, log time "
                                      f"{rec.log_time}) is not a ccomm value: {e}") from None
         elif isinstance(rec, Metadata) and rec.name == METADATA_NAME:
             node = rec.metadata.get("node", node)
+            try:  # the start on the recorder's CLOCK_MONOTONIC, the clock of source times
+                start_mono = int(rec.metadata["started_realtime_ns"]) - int(rec.metadata["clock_offset_ns"])
+            except (KeyError, ValueError):
+                start_mono = None
         elif isinstance(rec, Footer):
             complete = True
     if not complete:

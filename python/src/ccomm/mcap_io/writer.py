@@ -10,6 +10,7 @@ that holds every chunk written so far (a chunk is closed at least once a second)
 """
 from __future__ import annotations
 
+import heapq
 import json
 import os
 import select
@@ -17,13 +18,13 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import IO, Any, Dict, List, Optional
+from typing import IO, Any, Dict, List, Optional, Tuple
 
 from mcap.writer import CompressionType, Writer
 
 from .capi import SignalDesc
-from .schema import (FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
-                     channel_metadata, json_schema, message_encoder, schema_name)
+from .schema import (FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
+                     WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
 
 COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                "zstd": CompressionType.ZSTD}
@@ -80,6 +81,9 @@ class RecordingWriter:
         self.channel: Dict[int, int] = {}
         self.file_opened = 0.0
         self.rotating = o.rotate_bytes > 0 or o.rotate_seconds > 0
+        # messages not yet written: (log time, arrival order, channel, data, publish time, seq)
+        self.held: List[Tuple[int, int, int, bytes, int, int]] = []
+        self.order = 0
 
     # ---- files ---------------------------------------------------------------------
     def _open(self) -> None:
@@ -105,8 +109,11 @@ class RecordingWriter:
         self.mcap = w
         self.file_opened = time.monotonic()
 
-    def _close(self) -> None:
+    def _close(self, drain: bool = True) -> None:
+        """Ends the file; with `drain` (the recording ends) after every held message."""
         if self.mcap is not None and self.stream is not None:
+            if drain:
+                self._write_held(1 << 63)
             self.mcap.finish()
             self.stream.close()
             self.files.bytes_done += os.path.getsize(self.files.paths[-1])
@@ -121,7 +128,7 @@ class RecordingWriter:
             return
         if (self.o.rotate_bytes and self._size() >= self.o.rotate_bytes) or \
            (self.o.rotate_seconds and time.monotonic() - self.file_opened >= self.o.rotate_seconds):
-            self._close()
+            self._close(drain=False)  # held values go into the next file, still in order
             self._open()
 
     def total_bytes(self) -> int:
@@ -135,8 +142,13 @@ class RecordingWriter:
         vbytes, stats, offset = self.value_bytes, self.stats, self.o.clock_offset_ns
         unpack_from, head = RECORD.unpack_from, RECORD.size
         pos, end, n = 0, len(buf), 0
+        held, started = self.held, self.o.started_ns
         while pos + head <= end:
             sid, status, flags, seq, recv, src, lost = unpack_from(buf, pos)
+            if sid == WATERMARK_ID:  # every value received up to recv has been captured
+                self._write_held(recv + offset)
+                pos += head
+                continue
             size = vbytes[sid]
             if pos + head + size > end:
                 break
@@ -151,11 +163,23 @@ class RecordingWriter:
             st.values += 1
             st.last_seq, st.last_lost = seq, lost
             data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap)
-            add_message(channel[sid], recv + offset, data, src + offset, seq & 0xFFFFFFFF)
+            # an initial value (received before the start) is logged at the start
+            log_time = started if flags & FLAG_INITIAL else recv + offset
+            heapq.heappush(held, (log_time, self.order, channel[sid], data, src + offset, seq & 0xFFFFFFFF))
+            self.order += 1
             pos += head + size
             n += 1
         self.values += n
         return pos
+
+    def _write_held(self, upto: int) -> None:
+        """Writes the held messages logged at or before `upto`, in log-time order (values
+        of different signals are captured in turns, so they come out of order by up to
+        one turn; the watermark says when no earlier one can still come)."""
+        held, add_message = self.held, self.mcap.add_message
+        while held and held[0][0] <= upto:
+            log_time, _, channel, data, publish_time, sequence = heapq.heappop(held)
+            add_message(channel, log_time, data, publish_time, sequence)
 
     def flush(self) -> None:
         if self.mcap is not None:

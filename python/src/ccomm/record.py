@@ -38,6 +38,7 @@ examples:
   ccomm-record -s 'wheel*,arm0_pos' -o wheels.mcap
   ccomm-record --rotate-size 100 -o long.mcap    long-0000.mcap, long-0001.mcap, ... of 100 MB
   ccomm-record --recover cut.mcap -o fixed.mcap  a complete file from a truncated one
+  ccomm-record --profile ros2 -o run.mcap        std_msgs in CDR: ros2 bag play / rosbag2 read it
 
 Every value of the states the node receives needs its history tap, signals.xml:
 <node name="monitor" history="1024" ...> (without it they are polled, with a warning).
@@ -66,6 +67,10 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                    help="start a new file (NAME-0000.mcap, NAME-0001.mcap, ...) every MB megabytes")
     p.add_argument("--rotate-seconds", type=float, default=0, metavar="SEC",
                    help="start a new file every SEC seconds")
+    p.add_argument("--profile", choices=["ccomm", "ros2"], default="ccomm",
+                   help="ccomm (default): JSON messages with seq, times, freshness and loss, what "
+                        "ccomm-replay reads; ros2: std_msgs messages in CDR on /ccomm/SIGNAL, what "
+                        "ROS 2 tools (rosbag2, ros2 bag play) read")
     p.add_argument("--compression", choices=["none", "lz4", "zstd"], default="lz4",
                    help="chunk compression (default lz4: about 3x smaller, cheap)")
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
@@ -302,7 +307,8 @@ def record(a: argparse.Namespace) -> int:
     opts = WriterOptions(output=output, signals=sigs, node=h.node, compression=a.compression,
                          chunk_size=a.chunk_size, rotate_bytes=int(a.rotate_size * 1e6),
                          rotate_seconds=a.rotate_seconds, clock_offset_ns=offset,
-                         progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns())
+                         progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns(),
+                         profile=a.profile)
     # History cursors from the newest value kept (what polling would read first), made
     # before the start message: every value that arrives after it is recorded.
     cursors = [h.history_cursor(d.id, 1) if use_history(h, d) else None for d in sigs]

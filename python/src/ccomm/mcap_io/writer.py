@@ -22,6 +22,7 @@ from typing import IO, Any, Dict, List, Optional, Tuple
 
 from mcap.writer import CompressionType, Writer
 
+from . import ros2_profile
 from .capi import SignalDesc
 from .schema import (FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
                      WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
@@ -43,6 +44,7 @@ class WriterOptions:
     progress: str = "auto"  #: auto (a line in place on a terminal), lines, none
     stats_json: Optional[str] = None
     started_ns: int = 0
+    profile: str = "ccomm"  #: ccomm (JSON, what replay reads) or ros2 (std_msgs in CDR, ros2_profile.py)
 
 
 @dataclass
@@ -71,7 +73,8 @@ class RecordingWriter:
     def __init__(self, o: WriterOptions) -> None:
         self.o = o
         self.by_id: Dict[int, SignalDesc] = {d.id: d for d in o.signals}
-        self.encoders = {d.id: message_encoder(d)[1] for d in o.signals}
+        encoder = ros2_profile.message_encoder if o.profile == ros2_profile.PROFILE else message_encoder
+        self.encoders = {d.id: encoder(d)[1] for d in o.signals}
         self.value_bytes = {d.id: d.value_bytes for d in o.signals}
         self.stats = {d.id: SignalStats() for d in o.signals}
         self.files = FileSet()
@@ -91,17 +94,25 @@ class RecordingWriter:
         self.stream = open(path, "wb")
         self.files.paths.append(path)
         w = Writer(self.stream, chunk_size=self.o.chunk_size, compression=COMPRESSION[self.o.compression])
-        w.start(profile="", library="ccomm-record")
+        ros2 = self.o.profile == ros2_profile.PROFILE
+        w.start(profile=ros2_profile.PROFILE if ros2 else "", library="ccomm-record")
         schemas: Dict[str, int] = {}
         self.channel = {}
         for d in self.o.signals:
+            if ros2:
+                name, data, topic = ros2_profile.schema_and_channel(d)
+                if name not in schemas:
+                    schemas[name] = w.register_schema(name, ros2_profile.SCHEMA_ENCODING, data)
+                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name],
+                                                        channel_metadata(d))
+                continue
             name = schema_name(d)
             if name not in schemas:
                 schemas[name] = w.register_schema(name, SCHEMA_ENCODING, json_schema(d))
             self.channel[d.id] = w.register_channel(d.name, MESSAGE_ENCODING, schemas[name],
                                                     channel_metadata(d))
         w.add_metadata(METADATA_NAME, {
-            "format": FORMAT_VERSION, "node": self.o.node,
+            "format": FORMAT_VERSION, "profile": self.o.profile, "node": self.o.node,
             "clock_offset_ns": str(self.o.clock_offset_ns),
             "started_realtime_ns": str(self.o.started_ns),
             "file_index": str(len(self.files.paths) - 1),

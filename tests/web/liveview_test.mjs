@@ -286,7 +286,7 @@ await check("a page opened after the last event shows that event, not \"never\""
   const page3 = await openPage(browser2, []);
   try {
     const last = WRITER_COUNT / 25;
-    const r = await until(async () => { const r = await domRow(page3, "mode_request"); return r.value === String(last) && r; },
+    const r = await until(async () => { const r = await domRow(page3, "mode_request"); return r && r.value === String(last) && r; },
       5000, `mode_request ${last} on a page opened after the events`);
     assert(r.status !== "never" && r.seq !== "–", JSON.stringify(r));
   } finally {

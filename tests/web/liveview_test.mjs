@@ -296,7 +296,9 @@ await check("a page opened after the last event shows that event, not \"never\""
 
 await check("y labels of 7+ digit values are not cut, and the array plot has y labels", async () => {
   pub("tick", 123456789);
+  pub("joint_pos", 1234567.5, -2345678.25, 3456789);
   await until(async () => (await domRow(page2, "tick")).plotted === 123456789, 5000, "tick 123456789 plotted");
+  await until(async () => (await domRow(page2, "joint_pos")).plotted === 1234567.5, 5000, "joint_pos 1234567.5 plotted");
   await sleep(300);
   for (const name of ["tick", "joint_pos"]) {
     const ax = await page2.evaluate((s) => {

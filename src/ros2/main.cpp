@@ -46,7 +46,10 @@ bool ClaimNodeAndDomain(const Bridge* b) {
   const char* prefix = getenv("CCOMM_SHM_PREFIX");
   const std::string name = std::string(prefix && *prefix ? prefix : "/ccomm.") + b->node + ".ros2-domain" +
                            std::to_string(b->opt.domain);
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Left by a bridge of another user (root, then the unit's user): a read-only
+  // descriptor locks the same (only the pid in it is not ours then).
+  if (fd < 0 && errno == EACCES) fd = shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
   if (fd < 0) {
     fprintf(stderr, "ccomm-ros2: cannot create the lock %s in /dev/shm: %s\n", name.c_str(), strerror(errno));
     return false;

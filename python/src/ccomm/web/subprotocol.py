@@ -104,6 +104,8 @@ class SubprotocolRelay:
             await asyncio.gather(_copy(client_r, sdk_w), _copy(sdk_r, client_w))
         except (OSError, asyncio.IncompleteReadError, asyncio.LimitOverrunError, asyncio.TimeoutError):
             pass  # a client that went away or sent no request: only its own connection ends
+        except asyncio.CancelledError:
+            pass  # the server stops (stop()): the connection ends with it, nothing to report
         finally:
             for w in (client_w, sdk_w):
                 if w is not None:

@@ -111,6 +111,13 @@ struct Bridge {
 // Opens the node's segment, waiting (with one message) while ccommd has not created it.
 // Returns nullptr only when asked to stop.
 ccomm_client* OpenWaiting(Bridge* b);
+// One bridge per node and DDS domain: takes a lock the process holds until it ends.
+// False (with a message naming the holder) when another bridge holds it.
+bool ClaimNodeAndDomain(const Bridge* b);
+// A writer offering the route's current deadline (stale_after_ms): the deadline is an
+// immutable QoS in Cyclone DDS, so the writer is replaced when it changed. False with a
+// message if the new writer cannot be created.
+bool OfferCurrentDeadline(Bridge* b, Route* r, uint32_t offered_ms);
 // Finds the routes' signals again after a (re)open and checks that their type did not
 // change; false (with a message) if a route cannot be served by this handle.
 bool ResolveRoutes(Bridge* b, ccomm_client* c, const std::vector<Route*>& routes);

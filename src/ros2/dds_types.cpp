@@ -163,6 +163,23 @@ bool CreateDdsEntities(Bridge* b) {
   return true;
 }
 
+bool OfferCurrentDeadline(Bridge* b, Route* r, uint32_t offered_ms) {
+  if (!r->to_ros || r->desc.is_event || r->desc.stale_after_ms == offered_ms) return true;
+  dds_qos_t* q = WriterQos(*r);
+  const dds_entity_t w = dds_create_writer(b->participant, r->topic_entity, q, nullptr);
+  dds_delete_qos(q);
+  if (w < 0) {
+    fprintf(stderr, "ccomm-ros2: %s: cannot create a DDS writer with the new deadline: %s\n", r->name.c_str(),
+            dds_strretcode(w));
+    return false;
+  }
+  dds_delete(r->endpoint);
+  r->endpoint = w;
+  fprintf(stderr, "ccomm-ros2: %s: stale_after_ms changed, DDS deadline now %u ms (was %u)\n", r->name.c_str(),
+          r->desc.stale_after_ms, offered_ms);
+  return true;
+}
+
 void DestroyDdsEntities(Bridge* b) {
   if (b->participant > 0) dds_delete(b->participant);  // deletes topics, readers, writers
   b->participant = 0;

@@ -22,6 +22,22 @@ void SleepMs(int ms) {
 
 enum class Verdict { kOk, kBadLength, kBadValue };
 
+// A layout, when given, must describe exactly `count` elements in every dimension
+// (std_msgs/MultiArrayLayout: dim[i].size multiply to the element count, dim[i].stride =
+// dim[i].size * dim[i+1].stride, the last stride its size). Checking dim[0] alone let a
+// 3x2 layout with 3 values through. Bounded: at most dim_._length steps, no allocation.
+bool LayoutDescribes(const std_msgs_msg_dds__MultiArrayLayout_& layout, uint32_t count) {
+  const uint32_t n = layout.dim_._length;
+  if (n == 0) return true;  // no layout: a flat array
+  uint64_t elements = 1;
+  for (uint32_t i = n; i-- > 0;) {
+    const std_msgs_msg_dds__MultiArrayDimension_& d = layout.dim_._buffer[i];
+    elements *= d.size_;
+    if (elements > count || d.stride_ != elements) return false;  // also stops any overflow
+  }
+  return elements == count;
+}
+
 // The value bytes of a taken sample, if the sample fits the signal.
 Verdict Check(const Route& r, const void** value) {
   const uint32_t count = r.desc.count;
@@ -29,9 +45,7 @@ Verdict Check(const Route& r, const void** value) {
   if (r.type->is_array) {
     const ArraySample* a = static_cast<const ArraySample*>(r.sample);
     if (a->data_.length != count || a->layout_.data_offset_ != 0) return Verdict::kBadLength;
-    // A layout, when given, must describe the same count (dim[0].size = all elements).
-    if (a->layout_.dim_._length > 0 && a->layout_.dim_._buffer[0].size_ != count)
-      return Verdict::kBadLength;
+    if (!LayoutDescribes(a->layout_, count)) return Verdict::kBadLength;
     bytes = static_cast<const uint8_t*>(a->data_.buffer);
   } else {
     bytes = static_cast<const uint8_t*>(r.sample);

@@ -2,11 +2,16 @@
 // ccomm-ros2: start-up (routes from the node's signals and the options), the two
 // worker threads, signals and counters. See docs/integrations/ros2.md.
 #include <ctime>
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 
@@ -32,6 +37,39 @@ ccomm_client* OpenWaiting(Bridge* b) {
     nanosleep(&ts, nullptr);
   }
   return nullptr;
+}
+
+bool ClaimNodeAndDomain(const Bridge* b) {
+  // Beside the node's segment ($CCOMM_SHM_PREFIX, default "/ccomm."), so a test's own
+  // prefix gets its own lock. flock: released by the kernel however the holder ends,
+  // and still held by a stopped (SIGSTOP) bridge, which would resume publishing.
+  const char* prefix = getenv("CCOMM_SHM_PREFIX");
+  const std::string name = std::string(prefix && *prefix ? prefix : "/ccomm.") + b->node + ".ros2-domain" +
+                           std::to_string(b->opt.domain);
+  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Left by a bridge of another user (root, then the unit's user): a read-only
+  // descriptor locks the same (only the pid in it is not ours then).
+  if (fd < 0 && errno == EACCES) fd = shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
+  if (fd < 0) {
+    fprintf(stderr, "ccomm-ros2: cannot create the lock %s in /dev/shm: %s\n", name.c_str(), strerror(errno));
+    return false;
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char holder[32] = "";
+    const ssize_t n = pread(fd, holder, sizeof holder - 1, 0);
+    holder[n > 0 ? n : 0] = '\0';
+    fprintf(stderr, "ccomm-ros2: another ccomm-ros2 (pid %s) already bridges node %s on DDS domain %d: "
+                    "not starting a second one (every value would reach ROS 2 twice); stop it first "
+                    "(lock /dev/shm%s)\n", holder[0] ? holder : "?", b->node.c_str(), b->opt.domain, name.c_str());
+    close(fd);
+    return false;
+  }
+  char pid[32];
+  const int len = snprintf(pid, sizeof pid, "%d", static_cast<int>(getpid()));
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, static_cast<size_t>(len), 0) != len) {
+    // the pid is only for the message above: the lock itself is held
+  }
+  return true;  // fd stays open (and locked) until the process ends
 }
 
 bool ResolveRoutes(Bridge* b, ccomm_client* c, const std::vector<Route*>& routes) {
@@ -180,6 +218,7 @@ int main(int argc, char** argv) {
     PrintRoutes(&b);
     return 0;
   }
+  if (!ClaimNodeAndDomain(&b)) return 2;
   if (!CreateDdsEntities(&b)) {
     DestroyDdsEntities(&b);
     return 1;

@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <ctime>
+#include <vector>
 
 #include <cstdio>
 
@@ -161,7 +162,12 @@ void RunToRos(Bridge* b) {
   }
   ccomm_client* c = OpenWaiting(b);
   if (!c) return;
-  if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }
+  std::vector<uint32_t> offered_ms;  // deadlines offered before a reopen (reserved: no allocation then)
+  offered_ms.reserve(b->to_ros.size());
+  for (const Route* r : b->to_ros) offered_ms.push_back(r->desc.stale_after_ms);
+  bool offered = ResolveRoutes(b, c, b->to_ros);
+  for (size_t i = 0; offered && i < b->to_ros.size(); ++i) offered &= OfferCurrentDeadline(b, b->to_ros[i], offered_ms[i]);
+  if (!offered) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }
   StartRoutes(c, b->to_ros);
   while (!b->stop.load(std::memory_order_relaxed)) {
     ccomm_wait(c, 100);  // returns at once on a change; 100 ms to notice stop/retirement
@@ -176,7 +182,13 @@ void RunToRos(Bridge* b) {
       ccomm_close(c);
       c = OpenWaiting(b);
       if (!c) return;
+      offered_ms.clear();
+      for (const Route* r : b->to_ros) offered_ms.push_back(r->desc.stale_after_ms);
       if (!ResolveRoutes(b, c, b->to_ros)) { b->fatal = 1; b->stop = true; break; }
+      // A new configuration may change a deadline: offer the one it says (re-read here).
+      offered = true;
+      for (size_t i = 0; i < b->to_ros.size(); ++i) offered &= OfferCurrentDeadline(b, b->to_ros[i], offered_ms[i]);
+      if (!offered) { b->fatal = 1; b->stop = true; break; }
       b->reopens.fetch_add(1, std::memory_order_relaxed);
       StartRoutes(c, b->to_ros);  // a new segment counts anew
     } else if (err < 0) {

@@ -59,6 +59,84 @@ def read_values(path: str):
     return out
 
 
+def check_order(path: str) -> int:
+    """Messages in log-time order in the file itself (what `mcap doctor
+    --strict-message-order` checks), read by the `mcap` package in file order."""
+    prev, n, back = None, 0, 0
+    first_back = ""
+    with open(path, "rb") as f:
+        for _schema, channel, message in make_reader(f).iter_messages(log_time_order=False):
+            n += 1
+            if prev is not None and message.log_time < prev[0]:
+                back += 1
+                if not first_back:
+                    first_back = "message %d (%s, log time %d) before %s's %d, by %.3f ms" % (
+                        n, channel.topic, message.log_time, prev[1], prev[0], (prev[0] - message.log_time) / 1e6)
+            if prev is None or message.log_time >= prev[0]:
+                prev = (message.log_time, channel.topic)
+    print("# %d messages, %d logged earlier than one before them%s" % (n, back, "; first: " + first_back if back else ""))
+    return 0 if n > 0 and back == 0 else 1
+
+
+def check_initial(path: str, signal: str, max_span_s: float) -> int:
+    """A recording started on a running system: `signal`'s first message is its value from
+    before the start, marked initial and logged at the start; every message lies within
+    max_span_s of the start; later messages are not initial."""
+    with open(path, "rb") as f:
+        r = make_reader(f)
+        meta = {m.name: m.metadata for m in r.iter_metadata()}
+    started = int(meta["ccomm"]["started_realtime_ns"])
+    times, mine = [], []
+    with open(path, "rb") as f:
+        for _schema, channel, message in make_reader(f).iter_messages(log_time_order=False):
+            times.append(message.log_time)
+            if channel.topic == signal:
+                mine.append((message.log_time, json.loads(message.data)))
+    span = (max(times) - min(times)) / 1e9 if times else 0.0
+    first = mine[0][1] if mine else {}
+    old = (mine[0][0] - started) / 1e9 if mine else 0.0
+    print("# %s: %d messages, first initial=%s logged %.3f s after the start (its receive time is "
+          "older); file spans %.2f s (limit %.1f)" % (signal, len(mine), first.get("initial"), old, span, max_span_s))
+    ok = (len(mine) >= 2 and first.get("initial") is True and mine[0][0] >= started and
+          not any(m.get("initial") for _, m in mine[1:]) and span <= max_span_s)
+    return 0 if ok else 1
+
+
+def check_ros2(path: str, config: str, node: str) -> int:
+    """A --profile ros2 recording, read by an independent ROS 2 reader (mcap-ros2-support,
+    pinned): profile ros2, every channel a std_msgs type (ros2msg) on /ccomm/SIGNAL with
+    CDR messages that decode; ccomm-latency's values (k = 1, 2, ... in every double `node`
+    produces) equal the message's sequence number, in order."""
+    from mcap_ros2.decoder import DecoderFactory
+    names = set(produced_by(config, node))
+    per_topic = defaultdict(list)
+    bad = []
+    with open(path, "rb") as f:
+        r = make_reader(f, decoder_factories=[DecoderFactory()])
+        profile = r.get_header().profile
+        for schema, channel, message, decoded in r.iter_decoded_messages(log_time_order=False):
+            if schema.encoding != "ros2msg" or channel.message_encoding != "cdr" or \
+                    not schema.name.startswith("std_msgs/msg/") or not channel.topic.startswith("/ccomm/"):
+                bad.append((channel.topic, schema.name, schema.encoding, channel.message_encoding))
+                continue
+            name = channel.topic[len("/ccomm/"):]
+            data = list(decoded.data) if hasattr(decoded.data, "__len__") else [decoded.data]
+            per_topic[name].append((message.sequence, data, schema.name))
+    wrong = 0
+    for name in sorted(names):
+        vals = per_topic.get(name, [])
+        off = [v for v in vals if any(x != float(v[0]) for x in v[1])]
+        seqs = [v[0] for v in vals]
+        if not vals or off or any(b <= a for a, b in zip(seqs, seqs[1:])):
+            wrong += 1
+            print(f"# {name}: {len(vals)} messages, {len(off)} with a value != seq (e.g. {off[:1]})")
+    types = sorted({v[2] for vs in per_topic.values() for v in vs})
+    print(f"# profile {profile!r}; {sum(len(v) for v in per_topic.values())} messages on {len(per_topic)} topics "
+          f"decoded by mcap-ros2-support; types {types}; {wrong} of {len(names)} signals of {node} wrong; "
+          f"foreign channels {bad[:3]}")
+    return 0 if profile == "ros2" and not bad and not wrong and names else 1
+
+
 def produced_by(config: str, node: str) -> list:
     return re.findall(r'<signal name="([^"]+)" type="double" producer="%s"' % node, open(config).read())
 
@@ -367,6 +445,12 @@ def daemon_losses(paths: list) -> int:
 
 def main() -> int:
     cmd, args = sys.argv[1], sys.argv[2:]
+    if cmd == "ros2":  # FILE CONFIG NODE
+        return check_ros2(sys.argv[2], sys.argv[3], sys.argv[4])
+    if cmd == "order":  # FILE
+        return check_order(sys.argv[2])
+    if cmd == "initial":  # FILE SIGNAL MAX_SPAN_S
+        return check_initial(sys.argv[2], sys.argv[3], float(sys.argv[4]))
     if cmd == "config":
         make_config(*args)
         return 0

@@ -23,6 +23,12 @@ check "A -> ROS 2: uint32 (UInt32)" a_to_ros ticks UInt32 uint32 1 20
 check "A -> ROS 2: int64 (Int64)" a_to_ros big Int64 int64 1 20
 check "A -> ROS 2: float[2] (Float32MultiArray)" a_to_ros gain Float32MultiArray float 2 20
 check "A -> ROS 2: bool (Bool)" a_to_ros ready Bool bool 1 20
+# The test participant types UInt8MultiArray's data as sequence<uint8> (XTypes TK_UINT8,
+# what ROS 2's IDL says), the bridge as sequence<octet>: with type information on its
+# endpoints, the bridge's Cyclone DDS 0.10.2 looked the peer's type up and crashed on it
+# (SIGSEGV in the type-lookup thread, upstream #1554).
+check "A -> ROS 2: bool[3] (UInt8MultiArray) to a peer whose type says sequence<uint8>" a_to_ros flags UInt8MultiArray bool 3 20
+check "  ... and the bridge is still running after that peer came and went" kill -0 "$BRIDGE_PID"
 check "A -> ROS 2: event int64[2], 200 in a burst, each once and in order (reliable keep-all)" \
   a_to_ros alarm Int64MultiArray int64 2 200 --event
 
@@ -52,6 +58,15 @@ after=$(bridge_stat setpoint refused_length)
 check "DDS samples of the wrong length (2, 4) or layout are refused and counted ($before -> $after)" \
   bash -c "[[ $((after - before)) -eq 3 ]]"
 check "  ... and nothing reached board A" bash -c "[[ $rc -ne 0 ]] && ! grep -q '^[0-9]' '$WORK/bad.watch'"
+# A layout is checked in every dimension: 3x2 (or strides that do not fit) with 3 values is
+# refused; 3x1 with 3 values is a correct layout of the same data and is written.
+before=$(bridge_stat setpoint refused_length); w_before=$(bridge_stat setpoint written)
+peer pub rt/ccomm/setpoint Float64MultiArray \
+  '[{"data":[1,2,3],"dims":[[3,6],[2,2]]},{"data":[1,2,3],"dims":[[3,3],[1,2]]},{"data":[7,8,9],"dims":[[3,3],[1,1]]}]' \
+  --interval 0.05 >/dev/null
+after=$(bridge_stat setpoint refused_length); w_after=$(bridge_stat setpoint written)
+check "a multi-dimensional layout is checked in every dimension (3x2 over 3 values refused: $before -> $after; 3x1 written: $w_before -> $w_after)" \
+  bash -c "[[ $((after - before)) -eq 2 && $((w_after - w_before)) -eq 1 ]]"
 peer pub rt/ccomm/setpoint Int32MultiArray '[[1,2,3]]' --match-timeout 3 >/dev/null 2>&1
 wrong=$(bridge_stat setpoint wrong_type_peers)
 check "a DDS writer of another type (Int32MultiArray) on the topic is refused and counted ($wrong)" \
@@ -152,16 +167,27 @@ stop_daemon planner
 start_rt_daemon planner
 sleep 0.3
 check "after a ccommd restart on B (same configuration) values flow both ways" flows
-sed 's|</ccomm>|  <signal name="extra" type="double" producer="control" consumers="planner"/>\n</ccomm>|' \
+# The new configuration also changes pos's stale_after_ms (50 -> 120 ms): the bridge must
+# offer the new deadline after it reattaches.
+sed -e 's|</ccomm>|  <signal name="extra" type="double" producer="control" consumers="planner"/>\n</ccomm>|' \
+    -e 's|<signal name="pos" type="double" producer="control" consumers="planner" stale_after_ms="50"/>|<signal name="pos" type="double" producer="control" consumers="planner" stale_after_ms="120"/>|' \
   "$HERE/ros2.xml" >"$WORK/ros2-changed.xml"
+check "the bridge offers pos's deadline of the configuration (50 ms)" peer deadline rt/ccomm/pos 50
 stop_daemon control
 stop_daemon planner
 start_rt_daemon control "$WORK/ros2-changed.xml"
 start_rt_daemon planner "$WORK/ros2-changed.xml"
 sleep 0.5
 check "after ccommd restarts with a new configuration the bridge reopens and values flow" flows
+check "  ... and after stale_after_ms changed to 120 ms in the new configuration, offers 120 ms" \
+  peer deadline rt/ccomm/pos 120
 reopens=$(bridge_stat - reopens)
 check "  ... the bridge counted its reopens ($reopens)" bash -c "[[ $reopens -ge 1 ]]"
+# A second bridge for the same node and domain would publish every value twice: refused.
+timeout 20 ip netns exec "$NS_P" env CCOMM_NODE=planner "$BIN/ccomm-ros2" --config "$HERE/ros2.xml" \
+  >"$WORK/second.out" 2>&1; rc=$?
+check "a second bridge on the same node and DDS domain is refused (exit 2, naming the first's pid) (exit $rc)" \
+  bash -c "[[ $rc -eq 2 ]] && grep -q 'another ccomm-ros2 (pid $BRIDGE_PID) already bridges node planner on DDS domain 42' '$WORK/second.out'"
 check "the bridge is still running after every DDS peer of this suite came and went" kill -0 "$BRIDGE_PID"
 errs=$(bridge_stat joints dds_errors)
 check "  ... without a DDS error ($errs)" bash -c "[[ $errs -eq 0 ]]"

@@ -7,6 +7,7 @@ types from ros_std_msgs.py). One job per run; results as JSON lines on stdout.
         the DDS type name std_msgs::msg::dds_::TYPE_ and USER_DATA typehash=<RIHS01>;
   ros_peer.py echo TOPIC TYPE --count N            take samples (value, source timestamp,
         arrival) until N arrived or --timeout; --deadline-ms D also records deadline misses
+  ros_peer.py deadline TOPIC MS                     a writer of TOPIC offers a deadline of MS
   ros_peer.py pub TOPIC TYPE VALUES_JSON           publish each value once a bridge reader
         matched (reliable), then linger so all are delivered
 """
@@ -135,12 +136,26 @@ def cmd_pub(args, dp):
     time.sleep(0.5)  # our side matched; give the reader's side time to match us too
     values = json.loads(args.values)
     for v in values:
-        wr.write(msgs.make(args.type, v) if not isinstance(v, dict) else msgs.make(args.type, v["data"], v.get("count")))
+        wr.write(msgs.make(args.type, v) if not isinstance(v, dict) else msgs.make(args.type, v["data"], v.get("count"), v.get("dims")))
         if args.interval:
             time.sleep(args.interval)
     time.sleep(args.linger)
     emit(published=len(values))
     return 0
+
+
+def cmd_deadline(args, dp):
+    """The deadline (ms) offered by the writers of one topic, as DDS discovery tells them."""
+    rd = BuiltinDataReader(dp, BuiltinTopicDcpsPublication)
+    end, seen = time.time() + args.timeout, None
+    while seen is None and time.time() < end:
+        for ep in rd.take(N=64):
+            if ep.topic_name == args.topic:
+                dl = ep.qos[Policy.Deadline].deadline if Policy.Deadline in ep.qos else None
+                seen = None if dl is None else dl / 1e6
+        time.sleep(0.05)
+    emit(topic=args.topic, deadline_ms=seen)
+    return 0 if seen is not None and abs(seen - args.expect_ms) < 0.5 else 1
 
 
 def main():
@@ -150,6 +165,10 @@ def main():
     d = sub.add_parser("discover")
     d.add_argument("topics", nargs="+")
     d.add_argument("--timeout", type=float, default=10)
+    dl = sub.add_parser("deadline")
+    dl.add_argument("topic")
+    dl.add_argument("expect_ms", type=float)
+    dl.add_argument("--timeout", type=float, default=10)
     for name in ("echo", "pub"):
         p = sub.add_parser(name)
         p.add_argument("topic")
@@ -169,7 +188,7 @@ def main():
             p.add_argument("--linger", type=float, default=1.0)
     args = ap.parse_args()
     dp = DomainParticipant(args.domain)
-    return {"discover": cmd_discover, "echo": cmd_echo, "pub": cmd_pub}[args.cmd](args, dp)
+    return {"discover": cmd_discover, "echo": cmd_echo, "pub": cmd_pub, "deadline": cmd_deadline}[args.cmd](args, dp)
 
 
 if __name__ == "__main__":

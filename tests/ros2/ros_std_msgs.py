@@ -122,12 +122,15 @@ PUBLISHED_HASHES = {
 }
 
 
-def make(name, values, count=None):
-    """A sample of std_msgs type `name` ("Float64", "Int32MultiArray", ...)."""
+def make(name, values, count=None, dims=None):
+    """A sample of std_msgs type `name` ("Float64", "Int32MultiArray", ...); an array's
+    layout is one dimension of `count` (default: the values) or `dims`, [[size, stride]...]."""
     cls = TYPES[name]
     if not name.endswith("MultiArray"):
         return cls(data_=values)
     values = list(values)
     n = len(values) if count is None else count
-    layout = MultiArrayLayout_(dim_=[MultiArrayDimension_(label_="", size_=n, stride_=n)], data_offset_=0)
+    dims = dims if dims is not None else [[n, n]]
+    layout = MultiArrayLayout_(dim_=[MultiArrayDimension_(label_="", size_=size, stride_=stride)
+                                     for size, stride in dims], data_offset_=0)
     return cls(layout_=layout, data_=values)

@@ -7,8 +7,10 @@ import WebSocket from "ws";
 const { FoxgloveClient } = wsProtocol;
 
 export class FoxgloveProbe {
-  constructor(url) {
+  // protocols: the subprotocols offered (default both names, as current clients do)
+  constructor(url, protocols = ["foxglove.sdk.v1", "foxglove.websocket.v1"]) {
     this.url = url;
+    this.protocols = protocols;
     this.channels = new Map();      // topic -> advertised channel
     this.messages = new Map();      // topic -> [{ t, msg }]
     this.subs = new Map();          // subscription id -> topic
@@ -20,7 +22,7 @@ export class FoxgloveProbe {
   async connect(timeoutMs = 5000) {
     // foxglove.sdk.v1 is foxglove.websocket.v1 under the name foxglove-sdk servers accept;
     // FoxgloveClient leaves the choice to the socket (ws-protocol >= 0.7.5).
-    const ws = new WebSocket(this.url, ["foxglove.sdk.v1", FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+    const ws = new WebSocket(this.url, this.protocols);
     this.ws = ws;
     this.client = new FoxgloveClient({ ws });
     this.client.on("error", (e) => this.errors.push(String(e)));

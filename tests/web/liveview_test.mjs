@@ -102,6 +102,21 @@ await check("protocol client: a never-written signal decodes as status never, se
          m.fresh === false && m.gap === 0, JSON.stringify(m));
 });
 
+for (const offered of [["foxglove.websocket.v1"], ["foxglove.sdk.v1"]]) {
+  await check(`a client offering only ${offered[0]} is accepted, answered with that name, and served`, async () => {
+    const old = new FoxgloveProbe(WS_URL, offered);
+    try {
+      await old.connect();
+      assert(old.ws.protocol === offered[0], "server chose " + JSON.stringify(old.ws.protocol));
+      old.subscribe("tick");
+      await old.waitFor("tick", () => true, 3000, "any message (keepalive within 1 s)");
+      assert(old.errors.length === 0, old.errors.join("; "));
+    } finally {
+      old.close();
+    }
+  });
+}
+
 await check("page loads in headless Chromium, from the server only (no other origin)", async () => {
   browser = await chromium.launch(LAUNCH);
   page = await openPage(browser, requests);
@@ -265,6 +280,37 @@ await check("the protocol client lost nothing while the browser died (every new 
   const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
   assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
   assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));
+});
+
+await check("a page opened after the last event shows that event, not \"never\"", async () => {
+  const page3 = await openPage(browser2, []);
+  try {
+    const last = WRITER_COUNT / 25;
+    const r = await until(async () => { const r = await domRow(page3, "mode_request"); return r && r.value === String(last) && r; },
+      5000, `mode_request ${last} on a page opened after the events`);
+    assert(r.status !== "never" && r.seq !== "–", JSON.stringify(r));
+  } finally {
+    await page3.close();
+  }
+});
+
+await check("y labels of 7+ digit values are not cut, and the array plot has y labels", async () => {
+  pub("tick", 123456789);
+  pub("joint_pos", 1234567.5, -2345678.25, 3456789);
+  await until(async () => (await domRow(page2, "tick")).plotted === 123456789, 5000, "tick 123456789 plotted");
+  await until(async () => (await domRow(page2, "joint_pos")).plotted === 1234567.5, 5000, "joint_pos 1234567.5 plotted");
+  await sleep(300);
+  for (const name of ["tick", "joint_pos"]) {
+    const ax = await page2.evaluate((s) => {
+      const u = window.ccommView.charts[s].plot, a = u.axes[1];
+      u.ctx.font = a.font[0];
+      const labels = (a._values || []).map(String);
+      const widest = Math.max(0, ...labels.map((v) => u.ctx.measureText(v).width / devicePixelRatio));
+      return { show: a.show !== false, labels, widest, room: a._size - a.ticks.size - a.gap };
+    }, name);
+    assert(ax.show && ax.labels.length >= 2, name + ": y labels " + JSON.stringify(ax));
+    assert(ax.widest <= ax.room, `${name}: widest y label ${ax.widest.toFixed(1)} px > room ${ax.room} px: ${ax.labels}`);
+  }
 });
 
 await check("ccommd stopped: every client is told (status message, page banner), and told when it is back", async () => {

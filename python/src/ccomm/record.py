@@ -31,7 +31,7 @@ from .mcap_io import require_mcap
 from . import _native
 from ._errors import E_CORRUPT, CcommError, error_text
 from .client import Client, SignalInfo
-from .mcap_io.schema import RECORD
+from .mcap_io.schema import FLAG_INITIAL, RECORD, WATERMARK_ID
 
 EXAMPLES = """\
 examples:
@@ -40,6 +40,7 @@ examples:
   ccomm-record -s 'wheel*,arm0_pos' -o wheels.mcap
   ccomm-record --rotate-size 100 -o long.mcap    long-0000.mcap, long-0001.mcap, ... of 100 MB
   ccomm-record --recover cut.mcap -o fixed.mcap  a complete file from a truncated one
+  ccomm-record --profile ros2 -o run.mcap        std_msgs in CDR: ros2 bag play / rosbag2 read it
 
 Every value of the states the node receives needs its history tap, signals.xml:
 <node name="monitor" history="1024" ...> (without it they are polled, with a warning).
@@ -68,6 +69,10 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                    help="start a new file (NAME-0000.mcap, NAME-0001.mcap, ...) every MB megabytes")
     p.add_argument("--rotate-seconds", type=float, default=0, metavar="SEC",
                    help="start a new file every SEC seconds")
+    p.add_argument("--profile", choices=["ccomm", "ros2"], default="ccomm",
+                   help="ccomm (default): JSON messages with seq, times, freshness and loss, what "
+                        "ccomm-replay reads; ros2: std_msgs messages in CDR on /ccomm/SIGNAL, what "
+                        "ROS 2 tools (rosbag2, ros2 bag play) read")
     p.add_argument("--compression", choices=["none", "lz4", "zstd"], default="lz4",
                    help="chunk compression (default lz4: about 3x smaller, cheap)")
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
@@ -185,6 +190,7 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
               ctypes.addressof(cur) if cur is not None else 0)
              for i, (d, b, cur) in enumerate(zip(sigs, bufs, cursors))]
     last_seq = [0] * len(sigs)
+    first = [True] * len(sigs)  # no value of the signal read yet
     # History-read signals: the cursor's overrun at the previous value, and the values lost
     # before reaching this node so far. A jump in seq is either values the cursor fell too
     # far behind for (its overrun grew: the recorder missed them, the `gap` says so) or
@@ -225,7 +231,8 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                     elif seq > prev + 1:
                         lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
                     last_seq[i], last_overrun[i] = seq, overrun
-                    out += pack(sid, 0, 0, seq, recv, src, lost_so_far[i])
+                    out += pack(sid, 0, FLAG_INITIAL if prev == 0 and recv < start else 0, seq, recv, src,
+                                lost_so_far[i])
                     out += view
                 continue
             while True:
@@ -242,11 +249,17 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                         delay.max_ns = age
                     if age >= 1_000_000:
                         delay.over_1ms += 1
+                    if not event and first[i]:  # a state's value already there at the start
+                        first[i] = False
+                        if t - age < start:
+                            flags |= FLAG_INITIAL
                     out += pack(sid, status, flags, seq, t - age, src, lost)
                     out += view
                 if not event:
                     break
         if len(out) >= 65536 or ((out or pending) and t - last_send >= 20_000_000):
+            # every value received up to t has now been read: the writer may write those
+            out += pack(WATERMARK_ID, 0, 0, 0, t, 0, 0)
             pending += out
             out.clear()
             _write_some(fd, pending)
@@ -300,7 +313,8 @@ def record(a: argparse.Namespace) -> int:
     opts = WriterOptions(output=output, signals=sigs, node=node, compression=a.compression,
                          chunk_size=a.chunk_size, rotate_bytes=int(a.rotate_size * 1e6),
                          rotate_seconds=a.rotate_seconds, clock_offset_ns=offset,
-                         progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns())
+                         progress=a.progress, stats_json=a.stats_json, started_ns=time.time_ns(),
+                         profile=a.profile)
     # History cursors from the newest value kept (what polling would read first), made
     # before the start message: every value that arrives after it is recorded.
     cursors = [c.signal(d.name).history(1).cursor if use_history(c, d) else None for d in sigs]

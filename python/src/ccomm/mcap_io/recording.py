@@ -10,7 +10,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Iterator, List, Optional, Set, Tuple
 
-from mcap.records import Channel, Footer, Message, Metadata, Schema
+from mcap.records import Channel, Footer, Header, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 
@@ -69,6 +69,9 @@ def _damaged(path: str, e: Exception, messages: int) -> RecordingError:
 def _channel_signal(path: str, ch: Channel, schemas: Dict[int, Schema]) -> RecordedSignal:
     md = ch.metadata
     s = schemas.get(ch.schema_id)
+    if ch.message_encoding == "cdr" and "ccomm.type" in md:
+        raise RecordingError(f"{path}: recorded with --profile ros2 (for ROS 2 tools): ccomm-replay "
+                             "reads recordings of the default profile (ccomm-record --profile ccomm)")
     if s is None or s.encoding != SCHEMA_ENCODING or not s.name.startswith(SCHEMA_PREFIX) or \
             ch.message_encoding != "json" or "ccomm.type" not in md:
         raise RecordingError(f"{path}: channel '{ch.topic}' was not written by ccomm-record "
@@ -110,6 +113,7 @@ def load(path: str, wanted: Optional[Callable[[str], bool]] = None) -> Recording
     packers: Dict[int, Callable[[object], bytes]] = {}
     signals: Dict[str, RecordedSignal] = {}
     node, messages, complete = "", 0, False
+    start_mono: Optional[int] = None
     it = _records(path)
     while True:
         try:
@@ -141,13 +145,20 @@ def load(path: str, wanted: Optional[Callable[[str], bool]] = None) -> Recording
             sig = wanted_sig
             try:
                 m = json.loads(rec.data)
-                sig.values.append((int(m["source_time_ns"]), int(m["seq"]),
-                                   packers[rec.channel_id](m["value"])))
+                t = int(m["source_time_ns"])
+                if m.get("initial") and start_mono is not None:
+                    # already there at the start: replayed at the start, not after its old gap
+                    t = max(t, start_mono)
+                sig.values.append((t, int(m["seq"]), packers[rec.channel_id](m["value"])))
             except (ValueError, KeyError, TypeError, struct.error) as e:
                 raise RecordingError(f"{path}: message {messages} ({sig.name}, log time "
                                      f"{rec.log_time}) is not a ccomm value: {e}") from None
         elif isinstance(rec, Metadata) and rec.name == METADATA_NAME:
             node = rec.metadata.get("node", node)
+            try:  # the start on the recorder's CLOCK_MONOTONIC, the clock of source times
+                start_mono = int(rec.metadata["started_realtime_ns"]) - int(rec.metadata["clock_offset_ns"])
+            except (KeyError, ValueError):
+                start_mono = None
         elif isinstance(rec, Footer):
             complete = True
     if not complete:
@@ -167,7 +178,7 @@ def recover(src: str, dst: str) -> Tuple[int, str]:
     except OSError as e:
         raise RecordingError(f"{dst}: cannot write: {e.strerror}") from None
     w: Any = Writer(out, compression=CompressionType.LZ4)  # its methods are not annotated
-    w.start(profile="", library="ccomm-record --recover")
+    started = False
     schema_ids: Dict[int, int] = {}
     channel_ids: Dict[int, int] = {}
     seen_meta: Set[str] = set()
@@ -185,6 +196,9 @@ def recover(src: str, dst: str) -> Tuple[int, str]:
         except Exception as e:
             why = str(_damaged(src, e, n))
             break
+        if not started:  # the input's profile (a ros2 recording stays one)
+            w.start(profile=rec.profile if isinstance(rec, Header) else "", library="ccomm-record --recover")
+            started = True
         if isinstance(rec, Schema) and rec.id not in schema_ids:
             schema_ids[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
         elif isinstance(rec, Channel) and rec.id not in channel_ids and rec.schema_id in schema_ids:
@@ -200,6 +214,8 @@ def recover(src: str, dst: str) -> Tuple[int, str]:
         elif isinstance(rec, Footer):
             why = ""
             break
+    if not started:
+        w.start(profile="", library="ccomm-record --recover")
     w.finish()
     out.close()
     return n, why

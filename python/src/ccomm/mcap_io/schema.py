@@ -18,8 +18,11 @@ lost            values of the signal ccomm knows were lost before this one (the
                 counter of ccomm_info: network gaps and overruns; cumulative)
 gap             values the recorder did not see between the previous message and this one
                 (a jump in seq); 0 in a complete recording
+initial         true for a state's value that was already there when the recording
+                started (it arrived before): logged at the start, its own times kept
 
-The MCAP log time is the receive time and the publish time the source time, both moved
+Messages are in log-time order. The MCAP log time is the receive time (for an initial
+value, the recording's start) and the publish time the source time, both moved
 to the Unix epoch by the offset between CLOCK_REALTIME and CLOCK_MONOTONIC at the start
 of the recording (in the "ccomm" metadata record); the publish time is exact only when
 the producer shares the recorder's clock (one host).
@@ -42,6 +45,11 @@ FORMAT_VERSION = "1"
 # receive time, source time, lost; then value_bytes bytes of value.
 RECORD = struct.Struct("<HBBQqQQ")
 FLAG_SAFE_VALUE = 0x1
+# The signal's first value, received before the recording started: logged at the start.
+FLAG_INITIAL = 0x2
+# A record with this signal id (and no value bytes) is a watermark: the capture has read
+# every value that arrived up to its receive time, so the writer can write those in order.
+WATERMARK_ID = 0xFFFF
 
 
 def schema_name(desc: SignalInfo) -> str:
@@ -69,6 +77,8 @@ def json_schema(desc: SignalInfo) -> bytes:
             "safe_value": {"type": "boolean", "description": "value is the configured safe value"},
             "lost": dict(integer, description="values known lost before this one (cumulative)"),
             "gap": dict(integer, description="values the recorder missed just before this one"),
+            "initial": {"type": "boolean", "description": "already there when the recording started: "
+                        "logged at the start, its own times kept"},
         },
         "required": ["value", "seq", "source_time_ns", "receive_time_ns", "status", "lost", "gap"],
     }
@@ -109,7 +119,7 @@ def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
     floating = desc.type_name in ("float", "double")
     head = '{"value":'
     tail = ('"seq":%d,"source_time_ns":%d,"receive_time_ns":%d,"status":"%s",'
-            '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d}')
+            '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d,"initial":%s}')
     unpack_from = vs.unpack_from
     scalar = desc.count == 1
 
@@ -127,6 +137,6 @@ def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
         return (head + text + "," + tail % (
             seq, src, recv, STATUS_NAMES[status] if status < 4 else "?",
             "true" if status == 0 else "false", "true" if flags & FLAG_SAFE_VALUE else "false",
-            lost, gap)).encode()
+            lost, gap, "true" if flags & FLAG_INITIAL else "false")).encode()
 
     return vs, encode

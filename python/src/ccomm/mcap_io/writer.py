@@ -10,6 +10,7 @@ that holds every chunk written so far (a chunk is closed at least once a second)
 """
 from __future__ import annotations
 
+import heapq
 import json
 import os
 import select
@@ -17,13 +18,14 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import IO, Any, Dict, List, Optional
+from typing import IO, Any, Dict, List, Optional, Tuple
 
 from mcap.writer import CompressionType, Writer
 
 from ..client import SignalInfo
-from .schema import (FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
-                     channel_metadata, json_schema, message_encoder, schema_name)
+from . import ros2_profile
+from .schema import (FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
+                     WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
 
 COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                "zstd": CompressionType.ZSTD}
@@ -42,6 +44,7 @@ class WriterOptions:
     progress: str = "auto"  #: auto (a line in place on a terminal), lines, none
     stats_json: Optional[str] = None
     started_ns: int = 0
+    profile: str = "ccomm"  #: ccomm (JSON, what replay reads) or ros2 (std_msgs in CDR, ros2_profile.py)
 
 
 @dataclass
@@ -70,7 +73,8 @@ class RecordingWriter:
     def __init__(self, o: WriterOptions) -> None:
         self.o = o
         self.by_id: Dict[int, SignalInfo] = {d.id: d for d in o.signals}
-        self.encoders = {d.id: message_encoder(d)[1] for d in o.signals}
+        encoder = ros2_profile.message_encoder if o.profile == ros2_profile.PROFILE else message_encoder
+        self.encoders = {d.id: encoder(d)[1] for d in o.signals}
         self.value_bytes = {d.id: d.value_bytes for d in o.signals}
         self.stats = {d.id: SignalStats() for d in o.signals}
         self.files = FileSet()
@@ -80,6 +84,9 @@ class RecordingWriter:
         self.channel: Dict[int, int] = {}
         self.file_opened = 0.0
         self.rotating = o.rotate_bytes > 0 or o.rotate_seconds > 0
+        # messages not yet written: (log time, arrival order, channel, data, publish time, seq)
+        self.held: List[Tuple[int, int, int, bytes, int, int]] = []
+        self.order = 0
 
     # ---- files ---------------------------------------------------------------------
     def _open(self) -> None:
@@ -87,17 +94,25 @@ class RecordingWriter:
         self.stream = open(path, "wb")
         self.files.paths.append(path)
         w = Writer(self.stream, chunk_size=self.o.chunk_size, compression=COMPRESSION[self.o.compression])
-        w.start(profile="", library="ccomm-record")
+        ros2 = self.o.profile == ros2_profile.PROFILE
+        w.start(profile=ros2_profile.PROFILE if ros2 else "", library="ccomm-record")
         schemas: Dict[str, int] = {}
         self.channel = {}
         for d in self.o.signals:
+            if ros2:
+                name, data, topic = ros2_profile.schema_and_channel(d)
+                if name not in schemas:
+                    schemas[name] = w.register_schema(name, ros2_profile.SCHEMA_ENCODING, data)
+                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name],
+                                                        channel_metadata(d))
+                continue
             name = schema_name(d)
             if name not in schemas:
                 schemas[name] = w.register_schema(name, SCHEMA_ENCODING, json_schema(d))
             self.channel[d.id] = w.register_channel(d.name, MESSAGE_ENCODING, schemas[name],
                                                     channel_metadata(d))
         w.add_metadata(METADATA_NAME, {
-            "format": FORMAT_VERSION, "node": self.o.node,
+            "format": FORMAT_VERSION, "profile": self.o.profile, "node": self.o.node,
             "clock_offset_ns": str(self.o.clock_offset_ns),
             "started_realtime_ns": str(self.o.started_ns),
             "file_index": str(len(self.files.paths) - 1),
@@ -105,8 +120,11 @@ class RecordingWriter:
         self.mcap = w
         self.file_opened = time.monotonic()
 
-    def _close(self) -> None:
+    def _close(self, drain: bool = True) -> None:
+        """Ends the file; with `drain` (the recording ends) after every held message."""
         if self.mcap is not None and self.stream is not None:
+            if drain:
+                self._write_held(1 << 63)
             self.mcap.finish()
             self.stream.close()
             self.files.bytes_done += os.path.getsize(self.files.paths[-1])
@@ -121,7 +139,7 @@ class RecordingWriter:
             return
         if (self.o.rotate_bytes and self._size() >= self.o.rotate_bytes) or \
            (self.o.rotate_seconds and time.monotonic() - self.file_opened >= self.o.rotate_seconds):
-            self._close()
+            self._close(drain=False)  # held values go into the next file, still in order
             self._open()
 
     def total_bytes(self) -> int:
@@ -135,8 +153,13 @@ class RecordingWriter:
         vbytes, stats, offset = self.value_bytes, self.stats, self.o.clock_offset_ns
         unpack_from, head = RECORD.unpack_from, RECORD.size
         pos, end, n = 0, len(buf), 0
+        held, started = self.held, self.o.started_ns
         while pos + head <= end:
             sid, status, flags, seq, recv, src, lost = unpack_from(buf, pos)
+            if sid == WATERMARK_ID:  # every value received up to recv has been captured
+                self._write_held(recv + offset)
+                pos += head
+                continue
             size = vbytes[sid]
             if pos + head + size > end:
                 break
@@ -151,11 +174,23 @@ class RecordingWriter:
             st.values += 1
             st.last_seq, st.last_lost = seq, lost
             data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap)
-            add_message(channel[sid], recv + offset, data, src + offset, seq & 0xFFFFFFFF)
+            # an initial value (received before the start) is logged at the start
+            log_time = started if flags & FLAG_INITIAL else recv + offset
+            heapq.heappush(held, (log_time, self.order, channel[sid], data, src + offset, seq & 0xFFFFFFFF))
+            self.order += 1
             pos += head + size
             n += 1
         self.values += n
         return pos
+
+    def _write_held(self, upto: int) -> None:
+        """Writes the held messages logged at or before `upto`, in log-time order (values
+        of different signals are captured in turns, so they come out of order by up to
+        one turn; the watermark says when no earlier one can still come)."""
+        held, add_message = self.held, self.mcap.add_message
+        while held and held[0][0] <= upto:
+            log_time, _, channel, data, publish_time, sequence = heapq.heappop(held)
+            add_message(channel, log_time, data, publish_time, sequence)
 
     def flush(self) -> None:
         if self.mcap is not None:

@@ -22,6 +22,7 @@ from foxglove.websocket import Capability, ServerListener, StatusLevel
 
 from ..client import CcommError, Client, RetiredError, SignalInfo
 from .sampler import Sampler, json_schema, topic_of
+from .subprotocol import SubprotocolRelay
 
 STATIC_DIR = Path(__file__).with_name("static")
 # uPlot as `npm ci` installs it from this package's package.json (at build time, never
@@ -105,15 +106,25 @@ class LiveServer:
         self.context = foxglove.Context()
         self.channels = {i.name: foxglove.Channel(topic_of(i.name), schema=json_schema(i),
                                                   context=self.context) for i in self.infos}
-        self.ws = foxglove.start_server(name="ccomm " + self.node_name, host=host, port=ws_port,
+        # The SDK on loopback, behind the relay that also accepts foxglove.websocket.v1.
+        self.ws = foxglove.start_server(name="ccomm " + self.node_name, host="127.0.0.1", port=0,
                                         context=self.context, server_listener=cast(ServerListener, self.subs),
                                         capabilities=[Capability.Time], message_backlog_size=1024)
+        try:
+            self.relay = SubprotocolRelay(host, ws_port, int(self.ws.port))
+        except OSError:
+            self.ws.stop()
+            raise
         self.http = ThreadingHTTPServer((host, http_port), _handler(self))
         self.http.daemon_threads = True
         self.stop_event = threading.Event()
         self.published: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.changes: Dict[str, int] = {i.name: 0 for i in self.infos}
         self.gaps: Dict[str, int] = {i.name: 0 for i in self.infos}
+        # The newest message of each signal, for a page opened later (/last.json): the
+        # protocol has no latched channels, so an event signal would otherwise show
+        # "never" on that page until its next event.
+        self.last: Dict[str, Dict[str, Any]] = {}
         self.sampler_error: Optional[str] = None
         self.daemon_alive: Optional[bool] = None
         self.http_refused = 0
@@ -123,13 +134,14 @@ class LiveServer:
 
     @property
     def ws_port(self) -> int:
-        return int(self.ws.port)
+        return self.relay.port
 
     @property
     def http_port(self) -> int:
         return self.http.server_address[1]
 
     def start(self) -> None:
+        self.relay.start()
         for t in self._threads:
             t.start()
 
@@ -139,11 +151,13 @@ class LiveServer:
         for t in self._threads:
             t.join(timeout=5)
         self.http.server_close()
+        self.relay.stop()
         self.ws.stop()
 
     def _publish(self, name: str, message: Dict[str, Any]) -> None:
         now = time.time_ns()
         self.channels[name].log(message, log_time=now)
+        self.last[name] = {"log_time_ns": now, "message": message}  # one dict store: atomic
 
     def _sample_loop(self) -> None:
         """Wakes on any change of the node (ccomm_wait) or every 100 ms (a value going stale
@@ -202,6 +216,7 @@ class LiveServer:
         s: Dict[str, Any] = {"published": dict(self.published), "changes": dict(self.changes),
                              "gaps": dict(self.gaps),
                              "http_refused": self.http_refused,
+                             "ws_connections": self.relay.relayed, "ws_renamed": self.relay.renamed,
                              "sampler_error": self.sampler_error, "daemon_alive": self.daemon_alive}
         s.update(self.subs.snapshot())
         return s
@@ -209,7 +224,8 @@ class LiveServer:
 
 def _handler(server: LiveServer) -> type:
     class Handler(BaseHTTPRequestHandler):
-        """GET only: the page, its static files, /vendor (uPlot), /config.json, /stats.json."""
+        """GET only: the page, its static files, /vendor (uPlot), /config.json, /stats.json,
+        /last.json (the newest message of each signal with its log time)."""
 
         server_version = "ccomm-web"
         timeout = 10  # seconds a connection may idle: one that never sends cannot pin a thread
@@ -231,6 +247,8 @@ def _handler(server: LiveServer) -> type:
                 path = "/index.html"
             if path == "/config.json":
                 return self._send(json.dumps(server.config()).encode(), "application/json", body)
+            if path == "/last.json":
+                return self._send(json.dumps(dict(server.last)).encode(), "application/json", body)
             if path == "/stats.json":
                 return self._send(json.dumps(server.stats()).encode(), "application/json", body)
             if path.startswith("/vendor/") and path[8:] in VENDOR_FILES:

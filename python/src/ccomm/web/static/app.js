@@ -96,6 +96,20 @@ const PALETTE = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf
 
 function seriesCount(s) { return Math.min(s.count, 8); }
 
+// The y axis is as wide as its widest label needs (a fixed width cut 7+ digit labels),
+// measured with the axis's own font; uPlot calls this again while the labels settle.
+function yAxisSize(u, values, axisIdx, cycleNum) {
+  const axis = u.axes[axisIdx];
+  if (cycleNum > 1) return axis._size;  // uPlot's convention: keep the width it converged on
+  let size = axis.ticks.size + axis.gap;
+  const longest = (values || []).reduce((a, v) => (String(v).length > a.length ? String(v) : a), "");
+  if (longest) {
+    u.ctx.font = axis.font[0];
+    size += u.ctx.measureText(longest).width / devicePixelRatio;
+  }
+  return Math.ceil(size) + 4;
+}
+
 function buildCharts() {
   const box = $("#charts");
   for (const c of Object.values(view.charts)) c.plot && c.plot.destroy();
@@ -129,7 +143,7 @@ function buildCharts() {
     const data = [[]];
     for (let i = 1; i < series.length; i++) data.push([]);
     const plot = new uPlot({ width: Math.max(420, div.clientWidth - 8), height: 220, series,
-      scales: { x: { time: true } }, axes: [{}, { size: 60 }], legend: { show: s.count !== 1 },
+      scales: { x: { time: true } }, axes: [{}, { size: yAxisSize }], legend: { show: s.count !== 1 },
       cursor: { show: true } }, data, div);
     view.charts[name] = { div, plot, data, dirty: true, points: 0, staleSeries };
   }
@@ -239,6 +253,10 @@ function onBinary(buf) {
   const t = Number(dv.getBigUint64(5, true)) / 1e9;
   let m;
   try { m = JSON.parse(decoder.decode(new Uint8Array(buf, 13))); } catch (e) { return; }
+  show(name, t, m);
+}
+
+function show(name, t, m) {
   const row = view.rows[name];
   row.last = m;
   row.lastAt = performance.now();
@@ -254,6 +272,20 @@ function tick() {   // ~10 Hz: the table and the charts follow without redrawing
     if (row.dirtyRow || row.lastAt) { updateRow(row); row.dirtyRow = false; }
   }
   redraw();
+}
+
+// What each signal showed before this page opened: an event signal is published once per
+// event, so without this a page opened after the last event would say "never".
+async function loadLast() {
+  let last;
+  try {
+    last = await (await fetch("/last.json", { cache: "no-store" })).json();
+  } catch (e) {
+    return;  // an older server: the protocol alone fills the rows
+  }
+  for (const [name, { log_time_ns: t, message: m }] of Object.entries(last)) {
+    if (view.rows[name] && !view.rows[name].last) show(name, t / 1e9, m);
+  }
 }
 
 async function start() {
@@ -272,6 +304,7 @@ async function start() {
   buildTable(view.config);
   buildCharts();
   connect();
+  loadLast();
   setInterval(tick, 100);
 }
 

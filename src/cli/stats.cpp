@@ -23,6 +23,7 @@ struct Snapshot {
   std::vector<const char*> counter_names;
   std::vector<uint64_t> counters;
   std::vector<ccomm_peer_stats> peers;
+  std::vector<ccomm_peer_clock> clocks;  // per node, as peers
   std::vector<ccomm_signal_stats> sigs;
   std::vector<ccomm_signal_desc> descs;
 };
@@ -42,6 +43,9 @@ Snapshot Take(ccomm_client* c) {
     ccomm_peer_stats ps;
     ccomm_get_peer_stats(c, p, &ps);
     n.peers.push_back(ps);
+    ccomm_peer_clock pc;
+    ccomm_get_peer_clock(c, p, &pc);
+    n.clocks.push_back(pc);
   }
   for (int i = 0; i < ccomm_signal_count(c); ++i) {
     ccomm_signal_stats ss;
@@ -71,9 +75,14 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
       if (ps.is_self) continue;
       printf("%s{\"name\":\"%s\",\"alive\":%s,\"frames_rx\":%" PRIu64 ",\"frames_tx\":%" PRIu64
              ",\"frames_lost\":%" PRIu64 ",\"frames_reordered\":%" PRIu64 ",\"heartbeats_rx\":%" PRIu64
-             ",\"down_transitions\":%" PRIu64 ",\"last_rx_age_ms\":%.1f}",
+             ",\"down_transitions\":%" PRIu64 ",\"last_rx_age_ms\":%.1f",
              first ? "" : ",", ps.name, ps.alive ? "true" : "false", ps.frames_rx, ps.frames_tx, ps.frames_lost,
              ps.frames_reordered, ps.heartbeats_rx, ps.down_transitions, AgeMs(ps.last_rx_age_ns));
+      const ccomm_peer_clock& pc = now.clocks[static_cast<size_t>(&ps - now.peers.data())];
+      printf(",\"clock\":{\"known\":%s,\"offset_floor_ns\":%" PRId64 ",\"queue_delay_ms\":%.3f"
+             ",\"queue_delay_max_ms\":%.3f,\"frames_delayed\":%" PRIu64 "}}",
+             pc.known ? "true" : "false", pc.offset_floor_ns, static_cast<double>(pc.queue_delay_ns) / 1e6,
+             static_cast<double>(pc.queue_delay_max_ns) / 1e6, pc.frames_delayed);
       first = false;
     }
     printf("],\"signals\":[");
@@ -105,6 +114,21 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("%-12s %-5s %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %9" PRIu64 " %10" PRIu64 " %12.1f %8.0f\n", ps.name,
            ps.alive ? "yes" : "NO", ps.frames_rx, ps.frames_tx, ps.frames_lost, ps.frames_reordered, ps.heartbeats_rx,
            AgeMs(ps.last_rx_age_ns), before ? Rate(before->peers[p].frames_rx, ps.frames_rx, secs) : 0.0);
+  }
+  // Peers' clocks as bounded from their frames (ccomm_get_peer_clock): what ages include.
+  bool clock_header = false;
+  for (size_t p = 0; p < now.peers.size(); ++p) {
+    const ccomm_peer_clock& pc = now.clocks[p];
+    if (now.peers[p].is_self || !pc.known) continue;
+    if (!clock_header) {
+      printf("\nclocks: not synchronised; ages are local (arrival on this node plus the frame's queueing\n"
+             "delay beyond the fastest frame of the last 2-4 s)\n%-12s %16s %14s %14s %10s\n", "PEER",
+             "OFFSET_FLOOR_MS", "QUEUE_DELAY_MS", "MAX_DELAY_MS", "DELAYED");
+      clock_header = true;
+    }
+    printf("%-12s %16.3f %14.3f %14.3f %10" PRIu64 "\n", now.peers[p].name,
+           static_cast<double>(pc.offset_floor_ns) / 1e6, static_cast<double>(pc.queue_delay_ns) / 1e6,
+           static_cast<double>(pc.queue_delay_max_ns) / 1e6, pc.frames_delayed);
   }
   printf("\n%-24s %10s %10s %10s %8s %8s %6s %6s %8s %8s\n", "SIGNAL", "WRITES", "TX", "RX", "LOST", "OVERFLOW",
          "STALE", "->STL", "RX/S", "TX/S");

@@ -116,6 +116,19 @@ int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out)
   return 0;
 }
 
+int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out) {
+  if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= SegmentOf(c).node_count()) return CCOMM_E_INVAL;
+  const st::PeerStats& ps = SegmentOf(c).peer(static_cast<uint32_t>(node));
+  *out = ccomm_peer_clock{};
+  // Known once a frame of it was received (the receive path stores the floor with it).
+  out->known = ps.frames_rx.load(std::memory_order_acquire) > 0 ? 1 : 0;
+  out->offset_floor_ns = static_cast<int64_t>(ps.clock_floor_ns.load(std::memory_order_relaxed));
+  out->queue_delay_ns = ps.queue_delay_ns.load(std::memory_order_relaxed);
+  out->queue_delay_max_ns = ps.queue_delay_max_ns.load(std::memory_order_relaxed);
+  out->frames_delayed = ps.frames_delayed.load(std::memory_order_relaxed);
+  return 0;
+}
+
 int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {
   static const char* const kNames[] = {
       "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",

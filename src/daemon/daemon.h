@@ -12,6 +12,7 @@
 
 #include "config/config.h"
 #include "daemon/auth.h"
+#include "daemon/peer_clock.h"
 #include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
@@ -81,6 +82,7 @@ class Daemon {
     FrameStream stream[2];      // [0]: frames addressed to us, [1]: broadcast
     uint64_t last_rx_ns = 0;    // our clock at its last accepted frame (receive thread only)
     uint32_t ipv4 = 0;          // UDP: the configured source address (network order); 0 = any
+    PeerClock clock;            // its clock's offset floor: frames' queueing delays (peer_clock.h)
   };
   // Receiver rule 6: a signal's last applied value. The wire carries 32-bit sequence
   // numbers; `ext` extends them to 64 bits (serial arithmetic), so readers see a number

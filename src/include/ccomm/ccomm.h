@@ -267,6 +267,30 @@ typedef struct ccomm_peer_stats {
 CCOMM_API int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out);
 
 /**
+ * A peer's clock as this node's ccommd bounds it from the peer's frames alone (no clock
+ * synchronisation needed; docs/design.md, "Time"). Each frame's arrival minus its send
+ * time (the peer's CLOCK_MONOTONIC) is this node's clock minus the peer's plus the
+ * frame's delay; the smallest over the last 2-4 s (`offset_floor_ns`) stands for the
+ * path's fastest delay, and whatever a frame took beyond it is its queueing delay. A
+ * value's age (ccomm_info.age_ns) includes its frame's queueing delay, so a frame that
+ * waited seconds in a queue (a stopped ccommd, a full socket) does not read as fresh.
+ * The age is then exact to within the fastest one-way delay of the window (too young by
+ * at most that) plus the clocks' drift over the window (at most rho * 4 s, rho the
+ * boards' relative frequency error).
+ */
+typedef struct ccomm_peer_clock {
+  int32_t known;                /**< 1 once a frame arrived from it (the rest is valid) */
+  int32_t reserved;             /**< 0 */
+  int64_t offset_floor_ns;      /**< min(arrival - send time) over the window */
+  uint64_t queue_delay_ns;      /**< the last frame's delay beyond that floor */
+  uint64_t queue_delay_max_ns;  /**< the largest such delay since ccommd created the segment */
+  uint64_t frames_delayed;      /**< frames held >= 10 ms beyond the floor (their values aged by it) */
+} ccomm_peer_clock;
+/** Fills `out` for node `node` (known = 0 for this node itself); CCOMM_E_INVAL for a bad
+ *  handle or node index. */
+CCOMM_API int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out);
+
+/**
  * Daemon-wide counter `index` (0, 1, ... until CCOMM_E_INVAL): its name (e.g.
  * "frames_bad", see ccomm(1)) and value. `name` or `value` may be NULL.
  */

@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """Without clock synchronisation, still no stale value read as fresh (issue 29): the
 planner's ccommd is stopped for 5 s while the control board writes; the frames queue in
-the planner's socket. When it resumes, values written 4-5 s earlier arrive within
+the planner's socket (its ccommd alone stopped, or every process of the board). When it resumes, values written 4-5 s earlier arrive within
 milliseconds: each must read as stale with an age of seconds (peer_clock.h), not as fresh
 with an age under 1 ms. Raw Ethernet and UDP. Figures are printed with -s."""
 import os
 import signal
+import subprocess
 import tempfile
 import time
 
@@ -41,8 +42,14 @@ def echo_lines(proc):
     return lines
 
 
+def board_pids(pair, node):
+    out = subprocess.run(["ip", "netns", "pids", pair.ns[node]], capture_output=True, text=True, check=True).stdout
+    return [int(p) for p in out.split()]
+
+
+@pytest.mark.parametrize("stopped_part", ["ccommd", "board"])
 @pytest.mark.parametrize("transport", ["raw", "udp"])
-def test_values_queued_while_ccommd_was_stopped_read_stale(transport):
+def test_values_queued_while_ccommd_was_stopped_read_stale(transport, stopped_part):
     with tempfile.NamedTemporaryFile("w", suffix=".xml", delete=False) as f:
         f.write(CONFIG)
     try:
@@ -55,9 +62,13 @@ def test_values_queued_while_ccommd_was_stopped_read_stale(transport):
             assert wait_for(lambda: pair.echo_once("planner", "setpoint") == ("1", "fresh"), 10)
             writer.kill()
             writer.wait()
-            # Stop the planner's ccommd (ip netns exec execs: this pid is ccommd itself).
+            # Stop the planner's ccommd (ip netns exec execs: this pid is ccommd itself),
+            # or every process in its namespace (the reading application too).
             planner = pair.daemons["planner"]
-            os.kill(planner.pid, signal.SIGSTOP)
+            pids = [planner.pid] if stopped_part == "ccommd" else board_pids(pair, "planner")
+            assert planner.pid in pids
+            for pid in pids:
+                os.kill(pid, signal.SIGSTOP)
             stopped = time.monotonic()
             try:
                 # Values "2" are written only while it is stopped: every one of them queues.
@@ -68,7 +79,8 @@ def test_values_queued_while_ccommd_was_stopped_read_stale(transport):
                 # Stopped 5 s, and the newest queued value at least 4 s old on resuming.
                 time.sleep(max(stopped + 5.0, written + 4.0) - time.monotonic())
             finally:
-                os.kill(planner.pid, signal.SIGCONT)
+                for pid in pids:
+                    os.kill(pid, signal.SIGCONT)
             resumed = time.monotonic()
             min_true_age_us = int((resumed - written) * 1e6)
             # The queue drains at once; wait (bounded) until the reader has seen a "2".
@@ -78,9 +90,9 @@ def test_values_queued_while_ccommd_was_stopped_read_stale(transport):
             queued = [l for l in lines if l[0] == "2"]
             assert queued, "the reader saw none of the queued values: %s" % lines[-5:]
             fresh = [l for l in queued if l[1] == "fresh"]
-            print("\n%s: %d queued values read, ages %.3f-%.3f s (written >= %.3f s before the resume); "
+            print("\n%s, %s stopped: %d queued values read, ages %.3f-%.3f s (written >= %.3f s before the resume); "
                   "frames_delayed %d, queue_delay_max %.0f ms, fresh: %d"
-                  % (transport, len(queued), min(l[2] for l in queued) / 1e6, max(l[2] for l in queued) / 1e6,
+                  % (transport, stopped_part, len(queued), min(l[2] for l in queued) / 1e6, max(l[2] for l in queued) / 1e6,
                      min_true_age_us / 1e6, clock["frames_delayed"], clock["queue_delay_max_ms"], len(fresh)))
             assert not fresh, "values written >= %.1f s earlier read as fresh: %s" % (min_true_age_us / 1e6, fresh[:3])
             # Their ages tell how long they waited (the bound: too young by at most the

@@ -24,6 +24,7 @@ struct Snapshot {
   std::vector<uint64_t> counters;
   std::vector<ccomm_peer_stats> peers;
   std::vector<ccomm_peer_clock> clocks;  // per node, as peers
+  ccomm_clock_state clock{};              // this board's synchronisation (ptp4l)
   std::vector<ccomm_signal_stats> sigs;
   std::vector<ccomm_signal_desc> descs;
 };
@@ -33,6 +34,7 @@ Snapshot Take(ccomm_client* c) {
   n.t = ccomm_now();
   n.alive = ccomm_daemon_alive(c);
   n.generation = ccomm_daemon_generation(c);
+  ccomm_get_clock_state(c, &n.clock);
   const char* name;
   uint64_t value;
   for (int i = 0; ccomm_get_daemon_counter(c, i, &name, &value) == 0; ++i) {
@@ -69,7 +71,10 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
            now.alive ? "true" : "false", now.generation);
     for (size_t i = 0; i < now.counters.size(); ++i)
       printf("%s\"%s\":%" PRIu64, i ? "," : "", now.counter_names[i], now.counters[i]);
-    printf("},\"peers\":[");
+    printf("},\"clock\":{\"state\":\"%s\",\"port_state\":%d,\"offset_ns\":%" PRId64
+           ",\"path_delay_ns\":%" PRId64 "}", ccomm_clock_state_name(now.clock.state), now.clock.port_state,
+           now.clock.offset_ns, now.clock.path_delay_ns);
+    printf(",\"peers\":[");
     bool first = true;
     for (const ccomm_peer_stats& ps : now.peers) {
       if (ps.is_self) continue;
@@ -102,6 +107,12 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     return;
   }
   printf("node %s: ccommd %s (generation %u)\n", node, now.alive ? "alive" : "NOT RUNNING", now.generation);
+  if (now.clock.state == CCOMM_CLOCK_NONE)
+    printf("clock: none (no ptp4l answers): ages are local\n");
+  else
+    printf("clock: %s (ptp4l port state %d, offset %" PRId64 " ns)%s\n", ccomm_clock_state_name(now.clock.state),
+           now.clock.port_state, now.clock.offset_ns,
+           "; ages are local");
   printf("daemon:");
   for (size_t i = 0; i < now.counters.size(); ++i) {
     if (now.counters[i] || i < 3) printf(" %s=%" PRIu64, now.counter_names[i], now.counters[i]);

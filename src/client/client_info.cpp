@@ -129,6 +129,24 @@ int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out)
   return 0;
 }
 
+int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out) {
+  if (!c || !out) return CCOMM_E_INVAL;
+  const st::Segment& seg = SegmentOf(c);
+  const st::PeerStats& self = seg.peer(seg.node_id());
+  *out = ccomm_clock_state{};
+  const uint64_t word = self.clock_state.load(std::memory_order_acquire);
+  out->state = static_cast<int32_t>(word & 0xFF);
+  out->port_state = static_cast<int32_t>((word >> 8) & 0xFF);
+  out->offset_ns = static_cast<int64_t>(self.clock_offset_ns.load(std::memory_order_relaxed));
+  out->path_delay_ns = static_cast<int64_t>(self.clock_path_delay_ns.load(std::memory_order_relaxed));
+  return 0;
+}
+
+const char* ccomm_clock_state_name(int state) {
+  static const char* const kNames[] = {"none", "syncing", "synced", "lost"};
+  return state >= 0 && state < 4 ? kNames[state] : "?";
+}
+
 int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {
   static const char* const kNames[] = {
       "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",

@@ -13,6 +13,7 @@
 #include "config/config.h"
 #include "daemon/auth.h"
 #include "daemon/peer_clock.h"
+#include "daemon/ptp_state.h"
 #include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
@@ -31,6 +32,8 @@ struct DaemonOptions {
   bool no_realtime = false;    // --no-rt: skip mlockall / SCHED_FIFO (tests, unprivileged)
   int verbosity = 6;           // LogLevel
   int recv_timeout_ms = 50;
+  std::string ptp_socket = "/var/run/ptp4l";  // --ptp-socket; empty: not asked (ptp_state.h)
+  int64_t ptp_synced_within_ns = 1000000;      // |offset from master| of a synced slave
 };
 
 class Daemon {
@@ -46,6 +49,7 @@ class Daemon {
   void RunRx();   // receive thread body
   /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call every ~10 ms.
   void Supervise(uint64_t now_ns);
+  void SuperviseClock(uint64_t now_ns);  // ptp_state.h, published in ptp_clock.cpp
   void RequestStop();
   /// Detaches from the segment (which stays for the clients: their values go stale).
   void Shutdown();
@@ -183,6 +187,7 @@ class Daemon {
   std::vector<uint32_t> senders_;                 // indices of peers_tx_ that send
   uint32_t group_tx_ = 0;                         // index of the group stream (multicast fan-out)
   bool fanout_multicast_ = false;
+  ptp::Monitor ptp_;              // this board's clock state (supervision thread)
   std::vector<PeerRx> peers_rx_;
   std::vector<std::vector<uint32_t>> consumers_;  // signal -> the streams (peers_tx_) it goes out on
   std::vector<uint32_t> periodic_;                // forwarded periodic signal ids

@@ -40,6 +40,8 @@ const char kUsage[] =
     "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
     "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
     "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
+    "      --ptp-socket PATH ptp4l's management socket, asked for the clock state once a\n"
+    "                        second (default /var/run/ptp4l; 'none': not asked, state none)\n"
     "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
     "  -q, --quiet           warnings and errors only\n"
     "  -h, --help            this text\n"
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
       {"no-rt", no_argument, nullptr, 'R'},        {"verbose", no_argument, nullptr, 'v'},
       {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
       {"version", no_argument, nullptr, 'V'},      {"which-node", no_argument, nullptr, 'W'},
+      {"ptp-socket", required_argument, nullptr, 'P'},
       {nullptr, 0, nullptr, 0}};
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
@@ -94,6 +97,7 @@ int main(int argc, char** argv) {
         }
         break;
       case 'R': opt.no_realtime = true; break;
+      case 'P': opt.ptp_socket = strcmp(optarg, "none") == 0 ? "" : optarg; break;
       case 'W': opt.which_node = true; break;
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
       case 'q': verbosity = 4; break;

@@ -200,6 +200,10 @@ struct alignas(kCacheLine) PeerStats {
   std::atomic<uint64_t> frames_delayed;     // frames held >= 10 ms beyond that floor
   std::atomic<uint64_t> queue_delay_ns;     // the last frame's delay beyond the floor
   std::atomic<uint64_t> queue_delay_max_ns; // the largest so far
+  // This node's own entry only: its clock synchronisation (daemon/ptp_state.h).
+  std::atomic<uint64_t> clock_state;        // ClockState | PTP port state << 8 | 1 << 16 once published
+  std::atomic<uint64_t> clock_offset_ns;    // int64: ptp4l's offset from its master
+  std::atomic<uint64_t> clock_path_delay_ns;  // int64: ptp4l's mean path delay (P2P)
 };
 static_assert(sizeof(PeerStats) == 2 * kCacheLine, "PeerStats keeps layout 6's size");
 

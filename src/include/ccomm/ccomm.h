@@ -290,6 +290,25 @@ typedef struct ccomm_peer_clock {
  *  handle or node index. */
 CCOMM_API int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out);
 
+/** This board's clock synchronisation, as ccommd reads it from linuxptp's ptp4l once a second. */
+typedef enum ccomm_clock_state_code {
+  CCOMM_CLOCK_NONE = 0,    /**< no ptp4l answers (none running, or ccommd --ptp-socket none): ages are local */
+  CCOMM_CLOCK_SYNCING = 1, /**< ptp4l runs; its port is not (yet) a slave within the threshold, nor grandmaster */
+  CCOMM_CLOCK_SYNCED = 2,  /**< slave with |offset from master| <= 1 ms, or the grandmaster itself */
+  CCOMM_CLOCK_LOST = 3     /**< ptp4l answered before and stopped (killed, hung), or its port is faulty */
+} ccomm_clock_state_code;
+typedef struct ccomm_clock_state {
+  int32_t state;            /**< ccomm_clock_state_code; CCOMM_CLOCK_NONE also when ccommd never ran */
+  int32_t port_state;       /**< IEEE 1588 portState of ptp4l's port (9 slave, 6 master, 8 uncalibrated,
+                                 4 listening, 2 faulty...); 0 unknown */
+  int64_t offset_ns;        /**< ptp4l's last offset from its master (TIME_STATUS_NP master_offset) */
+  int64_t path_delay_ns;    /**< its peer mean path delay (P2P delay mechanism; 0 with E2E) */
+} ccomm_clock_state;
+/** Fills `out`; CCOMM_E_INVAL for a bad handle. */
+CCOMM_API int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out);
+/** "none", "syncing", "synced", "lost" (or "?"). */
+CCOMM_API const char* ccomm_clock_state_name(int state);
+
 /**
  * Daemon-wide counter `index` (0, 1, ... until CCOMM_E_INVAL): its name (e.g.
  * "frames_bad", see ccomm(1)) and value. `name` or `value` may be NULL.

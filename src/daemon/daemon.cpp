@@ -23,7 +23,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   cfg_ = &cfg;
   self_ = node_id;
   opt_ = opt;
-  ptp_.Configure(opt.ptp_socket, opt.ptp_synced_within_ns);
+  ptp_.Configure(opt.ptp_socket, opt.ptp_synced_within_ns, static_cast<uint8_t>(cfg.clock.domain));
   const NodeConfig& self = cfg.nodes[node_id];
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   heartbeat_ns_ = uint64_t{cfg.network.heartbeat_ms} * 1000000;

@@ -33,6 +33,8 @@ struct DaemonOptions {
   int verbosity = 6;           // LogLevel
   int recv_timeout_ms = 50;
   std::string ptp_socket = "/var/run/ptp4l";  // --ptp-socket; empty: not asked (ptp_state.h)
+  bool ptp_socket_given = false;               // --ptp-socket given: <clock socket=> does not apply
+  bool clock_config = false;                   // --clock-config: print ptp4l.conf for the node, exit
   int64_t ptp_synced_within_ns = 1000000;      // |offset from master| of a synced slave
 };
 

@@ -42,14 +42,14 @@ const char* ClockStateName(ClockState s) {
   return "?";
 }
 
-size_t BuildGet(uint8_t* out, size_t cap, uint16_t id, uint16_t sequence) {
+size_t BuildGet(uint8_t* out, size_t cap, uint16_t id, uint16_t sequence, uint8_t domain) {
   const size_t len = kManagementSize + kTlvHeaderSize;
   if (cap < len) return 0;
   memset(out, 0, len);
   out[0] = kMessageManagement;  // transportSpecific 0
   out[1] = 2;                   // versionPTP
   Put16(out + 2, static_cast<uint16_t>(len));
-  // domainNumber 0: over the Unix socket ptp4l answers whatever the domain (as pmc -u).
+  out[4] = domain;
   // sourcePortIdentity (20..29): zero; ptp4l answers to the socket address.
   Put16(out + 30, sequence);
   out[32] = 0x04;               // controlField: management
@@ -130,7 +130,7 @@ void Monitor::Poll(uint64_t now_ns) {
   memcpy(to.sun_path, path_.data(), path_.size());
   uint8_t msg[64];
   for (uint16_t id : {kIdTimeStatusNp, kIdPortDataSet}) {
-    const size_t len = BuildGet(msg, sizeof msg, id, ++sequence_);
+    const size_t len = BuildGet(msg, sizeof msg, id, ++sequence_, domain_);
     // ENOENT / ECONNREFUSED: no ptp4l; the silence decides (Evaluate).
     (void)sendto(fd_, msg, len, MSG_DONTWAIT | MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&to), sizeof to);
   }

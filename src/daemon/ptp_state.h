@@ -37,8 +37,10 @@ constexpr uint16_t kIdPortDataSet = 0x2004;
 constexpr uint16_t kIdTimeStatusNp = 0xC000;
 
 // A GET management message for `id`, to the local clock only (boundaryHops 0, every
-// port): 54 bytes written to `out` (at least that long). Returns its length.
-size_t BuildGet(uint8_t* out, size_t cap, uint16_t id, uint16_t sequence);
+// port), in PTP domain `domain` (ptp4l ignores management messages of another domain,
+// also on its Unix socket: pmc -d): 54 bytes written to `out`. Returns its length, 0 if
+// `cap` is too small.
+size_t BuildGet(uint8_t* out, size_t cap, uint16_t id, uint16_t sequence, uint8_t domain = 0);
 
 // What an answer carried (fields of the id it answered).
 struct Reply {
@@ -66,9 +68,10 @@ class Monitor {
   ~Monitor();
   // Where ptp4l listens (empty: never asked, the state stays none) and the largest
   // |offset from master| of a slave that counts as synced.
-  void Configure(std::string uds_path, int64_t synced_within_ns) {
+  void Configure(std::string uds_path, int64_t synced_within_ns, uint8_t domain) {
     path_ = std::move(uds_path);
     synced_within_ns_ = synced_within_ns;
+    domain_ = domain;
   }
   Monitor(const Monitor&) = delete;
   Monitor& operator=(const Monitor&) = delete;
@@ -92,6 +95,7 @@ class Monitor {
 
   std::string path_;
   int64_t synced_within_ns_ = 1000000;
+  uint8_t domain_ = 0;
   int fd_ = -1;
   std::string own_path_;        // the socket's bound name: ptp4l answers to it
   uint16_t sequence_ = 0;

@@ -3,6 +3,8 @@
 // and the clock state machine (none, syncing, synced, lost) from the answers and silences.
 #include "daemon/ptp_state.h"
 
+#include "daemon/ptp_config.h"
+
 #include <gtest/gtest.h>
 #include <string.h>
 
@@ -54,7 +56,10 @@ TEST(PtpManagement, GetIsTheMessagePmcSends) {
   EXPECT_EQ(m[48] << 8 | m[49], 1);  // MANAGEMENT TLV
   EXPECT_EQ(m[50] << 8 | m[51], 2);
   EXPECT_EQ(m[52] << 8 | m[53], 0xC000);
+  EXPECT_EQ(m[4], 0);     // domain 0 unless told
   EXPECT_EQ(BuildGet(m, 53, kIdTimeStatusNp, 1), 0u);
+  ASSERT_EQ(BuildGet(m, sizeof m, kIdPortDataSet, 1, 24), 54u);
+  EXPECT_EQ(m[4], 24);
 }
 
 TEST(PtpManagement, AnswersAreParsedAndAnythingElseRefused) {
@@ -92,7 +97,7 @@ void Feed(Monitor* m, const std::vector<uint8_t>& msg, uint64_t now) {
 
 TEST(PtpMonitor, StatesFollowPtp4l) {
   Monitor m;
-  m.Configure("", 1000000);
+  m.Configure("", 1000000, 0);
   uint64_t t = 100 * kS;
   EXPECT_FALSE(m.Evaluate(t));
   EXPECT_EQ(m.state(), ClockState::kNone);  // nobody ever answered
@@ -129,6 +134,35 @@ TEST(PtpMonitor, StatesFollowPtp4l) {
   Feed(&m, PortData(kPortFaulty, 0), t);
   m.Evaluate(t);
   EXPECT_EQ(m.state(), ClockState::kLost);
+}
+
+TEST(Ptp4lConfig, EachNodeItsRoleFromOneFile) {
+  const char* xml =
+      "<ccomm version=\"1\">\n"
+      "  <node name=\"control\" interface=\"eth0\" ip=\"10.42.0.1\"/>\n"
+      "  <node name=\"planner\" interface=\"enp2s0\" ip=\"10.42.0.2\" transport=\"udp\"/>\n"
+      "  <node name=\"vision\" interface=\"eth1\" ip=\"10.42.0.3\"/>\n"
+      "  <signal name=\"pos\" type=\"double\" producer=\"control\" consumers=\"vision\"/>\n"
+      "  <clock domain=\"3\" grandmaster=\"vision, control\" sync_interval_log=\"-4\"/>\n"
+      "</ccomm>\n";
+  SystemConfig cfg;
+  std::string err;
+  ASSERT_TRUE(ParseConfig(xml, "signals.xml", &cfg, &err)) << err;
+  const std::string control = Ptp4lConfig(cfg, 0, &err), planner = Ptp4lConfig(cfg, 1, &err),
+                    vision = Ptp4lConfig(cfg, 2, &err);
+  EXPECT_NE(control.find("[global]\ndomainNumber 3\npriority1 101\ntime_stamping software\nlogSyncInterval -4\n"
+                         "network_transport L2\nuds_address /var/run/ptp4l\n[eth0]\n"), std::string::npos) << control;
+  EXPECT_EQ(control.find("slaveOnly"), std::string::npos);
+  EXPECT_NE(vision.find("priority1 100\n"), std::string::npos) << vision;  // the first candidate wins
+  EXPECT_NE(planner.find("priority1 255\nslaveOnly 1\n"), std::string::npos) << planner;
+  EXPECT_NE(planner.find("network_transport UDPv4\n"), std::string::npos) << planner;
+  EXPECT_NE(planner.find("[enp2s0]\n"), std::string::npos) << planner;
+
+  SystemConfig none;
+  ASSERT_TRUE(ParseConfig(std::string(xml).replace(std::string(xml).find("  <clock"), 75, ""), "signals.xml", &none,
+                          &err)) << err;
+  EXPECT_EQ(Ptp4lConfig(none, 0, &err), "");
+  EXPECT_NE(err.find("no <clock> section"), std::string::npos) << err;
 }
 
 }  // namespace

@@ -3,9 +3,11 @@
 management socket once a second and shows none / syncing / synced / lost in the API
 (ccomm stats reads it through ccomm_get_clock_state) and its log. ptp4l runs in the two
 namespaces over the veth pair with software timestamping; control is the grandmaster
-(synced: the reference itself), planner a slave-only port. The planner's ptp4l is
-free-running (it never adjusts the clock: both namespaces share the host's), so its port
-stays UNCALIBRATED: syncing. Then the planner's ptp4l is killed: lost."""
+(synced: the reference itself), planner a slave-only port, both configured by
+`ccommd --clock-config` from the <clock> section of the one signals.xml. Two boards on
+one host need two management sockets and must leave the host's clock alone, so the test
+changes uds_address and adds free_running (the planner's port then stays UNCALIBRATED:
+syncing). Then the planner's ptp4l is killed: lost."""
 import os
 import shutil
 import signal
@@ -15,19 +17,13 @@ import time
 
 import pytest
 
-from harness import NodePair, wait_for
+from harness import BIN, DEFAULT_CONFIG, NodePair, wait_for
 
 PTP4L = shutil.which("ptp4l") or ("/usr/sbin/ptp4l" if os.path.exists("/usr/sbin/ptp4l") else None)
 
-COMMON = """[global]
-domainNumber 0
-time_stamping software
-free_running 1
-logSyncInterval -2
-logAnnounceInterval -2
-announceReceiptTimeout 3
-uds_address %s
-"""
+CLOCK = '<clock domain="5" grandmaster="control" sync_interval_log="-2"/>\n</ccomm>'
+# For two boards on one host only (see above); quick announces so the test is short.
+TEST_ONLY = "free_running 1\nlogAnnounceInterval -2\nannounceReceiptTimeout 3\n"
 
 
 def clock_state(pair, node):
@@ -38,7 +34,12 @@ def clock_state(pair, node):
 def test_clock_states_none_synced_syncing_lost():
     work = tempfile.mkdtemp(prefix="ccomm-ptp-")
     try:
-        with NodePair() as pair:
+        config = os.path.join(work, "signals.xml")
+        with open(DEFAULT_CONFIG) as f:
+            text = f.read()
+        with open(config, "w") as f:
+            f.write(text.replace("</ccomm>", CLOCK))
+        with NodePair(config=config) as pair:
             sock = {n: os.path.join(work, n + ".sock") for n in ("control", "planner")}
             for node in ("control", "planner"):
                 pair.start(node, extra=["--ptp-socket", sock[node]])
@@ -46,12 +47,18 @@ def test_clock_states_none_synced_syncing_lost():
             assert wait_for(lambda: all(clock_state(pair, n)["state"] == "none" for n in sock), 5)
             assert "clock: none" in pair.cli("planner", "stats").stdout
             ptp = {}
-            for node, extra in (("control", "priority1 10\n"), ("planner", "priority1 200\nslaveOnly 1\n")):
+            for node in ("control", "planner"):
+                generated = subprocess.run([os.path.join(BIN, "ccommd"), "-c", config, "-n", node, "--clock-config"],
+                                           capture_output=True, text=True, check=True).stdout
+                assert "domainNumber 5\n" in generated and "network_transport L2\n" in generated, generated
+                assert ("priority1 100\n" in generated) if node == "control" else ("slaveOnly 1\n" in generated)
+                assert generated.endswith("uds_address /var/run/ptp4l\n[eth0]\n"), generated
                 cfg = os.path.join(work, node + ".cfg")
                 with open(cfg, "w") as f:
-                    f.write(COMMON % sock[node] + extra)
+                    f.write(generated.replace("uds_address /var/run/ptp4l\n",
+                                              "uds_address %s\n%s" % (sock[node], TEST_ONLY)))
                 log = open(os.path.join(work, node + ".log"), "w")
-                ptp[node] = subprocess.Popen(pair.exec_prefix(node) + [PTP4L, "-f", cfg, "-i", "eth0", "-m"],
+                ptp[node] = subprocess.Popen(pair.exec_prefix(node) + [PTP4L, "-f", cfg, "-m"],  # interface: the file's [eth0]
                                              stdout=log, stderr=subprocess.STDOUT)
                 pair.bg.append(ptp[node])
             t0 = time.time()

@@ -132,8 +132,8 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     const ccomm_peer_clock& pc = now.clocks[p];
     if (now.peers[p].is_self || !pc.known) continue;
     if (!clock_header) {
-      printf("\nclocks: not synchronised; ages are local (arrival on this node plus the frame's queueing\n"
-             "delay beyond the fastest frame of the last 2-4 s)\n%-12s %16s %14s %14s %10s\n", "PEER",
+      printf("\npeer clocks, from their frames: ages are local, arrival on this node plus the frame's\n"
+             "queueing delay beyond the fastest frame of the last 2-4 s\n%-12s %16s %14s %14s %10s\n", "PEER",
              "OFFSET_FLOOR_MS", "QUEUE_DELAY_MS", "MAX_DELAY_MS", "DELAYED");
       clock_header = true;
     }

@@ -23,6 +23,8 @@ struct Snapshot {
   std::vector<const char*> counter_names;
   std::vector<uint64_t> counters;
   std::vector<ccomm_peer_stats> peers;
+  std::vector<ccomm_peer_clock> clocks;  // per node, as peers
+  ccomm_clock_state clock{};              // this board's synchronisation (ptp4l)
   std::vector<ccomm_signal_stats> sigs;
   std::vector<ccomm_signal_desc> descs;
 };
@@ -32,6 +34,7 @@ Snapshot Take(ccomm_client* c) {
   n.t = ccomm_now();
   n.alive = ccomm_daemon_alive(c);
   n.generation = ccomm_daemon_generation(c);
+  ccomm_get_clock_state(c, &n.clock);
   const char* name;
   uint64_t value;
   for (int i = 0; ccomm_get_daemon_counter(c, i, &name, &value) == 0; ++i) {
@@ -42,6 +45,9 @@ Snapshot Take(ccomm_client* c) {
     ccomm_peer_stats ps;
     ccomm_get_peer_stats(c, p, &ps);
     n.peers.push_back(ps);
+    ccomm_peer_clock pc;
+    ccomm_get_peer_clock(c, p, &pc);
+    n.clocks.push_back(pc);
   }
   for (int i = 0; i < ccomm_signal_count(c); ++i) {
     ccomm_signal_stats ss;
@@ -65,15 +71,23 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
            now.alive ? "true" : "false", now.generation);
     for (size_t i = 0; i < now.counters.size(); ++i)
       printf("%s\"%s\":%" PRIu64, i ? "," : "", now.counter_names[i], now.counters[i]);
-    printf("},\"peers\":[");
+    printf("},\"clock\":{\"state\":\"%s\",\"port_state\":%d,\"offset_ns\":%" PRId64
+           ",\"path_delay_ns\":%" PRId64 "}", ccomm_clock_state_name(now.clock.state), now.clock.port_state,
+           now.clock.offset_ns, now.clock.path_delay_ns);
+    printf(",\"peers\":[");
     bool first = true;
     for (const ccomm_peer_stats& ps : now.peers) {
       if (ps.is_self) continue;
       printf("%s{\"name\":\"%s\",\"alive\":%s,\"frames_rx\":%" PRIu64 ",\"frames_tx\":%" PRIu64
              ",\"frames_lost\":%" PRIu64 ",\"frames_reordered\":%" PRIu64 ",\"heartbeats_rx\":%" PRIu64
-             ",\"down_transitions\":%" PRIu64 ",\"last_rx_age_ms\":%.1f}",
+             ",\"down_transitions\":%" PRIu64 ",\"last_rx_age_ms\":%.1f",
              first ? "" : ",", ps.name, ps.alive ? "true" : "false", ps.frames_rx, ps.frames_tx, ps.frames_lost,
              ps.frames_reordered, ps.heartbeats_rx, ps.down_transitions, AgeMs(ps.last_rx_age_ns));
+      const ccomm_peer_clock& pc = now.clocks[static_cast<size_t>(&ps - now.peers.data())];
+      printf(",\"clock\":{\"known\":%s,\"offset_floor_ns\":%" PRId64 ",\"queue_delay_ms\":%.3f"
+             ",\"queue_delay_max_ms\":%.3f,\"frames_delayed\":%" PRIu64 "}}",
+             pc.known ? "true" : "false", pc.offset_floor_ns, static_cast<double>(pc.queue_delay_ns) / 1e6,
+             static_cast<double>(pc.queue_delay_max_ns) / 1e6, pc.frames_delayed);
       first = false;
     }
     printf("],\"signals\":[");
@@ -93,6 +107,12 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     return;
   }
   printf("node %s: ccommd %s (generation %u)\n", node, now.alive ? "alive" : "NOT RUNNING", now.generation);
+  if (now.clock.state == CCOMM_CLOCK_NONE)
+    printf("clock: none (no ptp4l answers): ages are local\n");
+  else
+    printf("clock: %s (ptp4l port state %d, offset %" PRId64 " ns)%s\n", ccomm_clock_state_name(now.clock.state),
+           now.clock.port_state, now.clock.offset_ns,
+           "; ages are local");
   printf("daemon:");
   for (size_t i = 0; i < now.counters.size(); ++i) {
     if (now.counters[i] || i < 3) printf(" %s=%" PRIu64, now.counter_names[i], now.counters[i]);
@@ -105,6 +125,21 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("%-12s %-5s %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %9" PRIu64 " %10" PRIu64 " %12.1f %8.0f\n", ps.name,
            ps.alive ? "yes" : "NO", ps.frames_rx, ps.frames_tx, ps.frames_lost, ps.frames_reordered, ps.heartbeats_rx,
            AgeMs(ps.last_rx_age_ns), before ? Rate(before->peers[p].frames_rx, ps.frames_rx, secs) : 0.0);
+  }
+  // Peers' clocks as bounded from their frames (ccomm_get_peer_clock): what ages include.
+  bool clock_header = false;
+  for (size_t p = 0; p < now.peers.size(); ++p) {
+    const ccomm_peer_clock& pc = now.clocks[p];
+    if (now.peers[p].is_self || !pc.known) continue;
+    if (!clock_header) {
+      printf("\npeer clocks, from their frames: ages are local, arrival on this node plus the frame's\n"
+             "queueing delay beyond the fastest frame of the last 2-4 s\n%-12s %16s %14s %14s %10s\n", "PEER",
+             "OFFSET_FLOOR_MS", "QUEUE_DELAY_MS", "MAX_DELAY_MS", "DELAYED");
+      clock_header = true;
+    }
+    printf("%-12s %16.3f %14.3f %14.3f %10" PRIu64 "\n", now.peers[p].name,
+           static_cast<double>(pc.offset_floor_ns) / 1e6, static_cast<double>(pc.queue_delay_ns) / 1e6,
+           static_cast<double>(pc.queue_delay_max_ns) / 1e6, pc.frames_delayed);
   }
   printf("\n%-24s %10s %10s %10s %8s %8s %6s %6s %8s %8s\n", "SIGNAL", "WRITES", "TX", "RX", "LOST", "OVERFLOW",
          "STALE", "->STL", "RX/S", "TX/S");

@@ -10,7 +10,6 @@
 
 #include <vector>
 
-#include "config/text.h"
 
 namespace ccomm {
 namespace cli {
@@ -66,24 +65,19 @@ std::string FormatValue(const ccomm_signal_desc& d, const void* value) {
 
 // The configuration's parser (safe_value) reads the same words the same way: one rule.
 static bool ParseOne(int type, const std::string& w, uint8_t* out, std::string* error) {
-  using config_detail::NumResult;
-  if (type < CCOMM_BOOL || type > CCOMM_DOUBLE) {
-    *error = "unknown type";
-    return false;
-  }
-  const NumResult r = config_detail::ParseValueElement(static_cast<ValueType>(type), w, out);
-  if (r == NumResult::kOk) return true;
-  if (r == NumResult::kRange) *error = "'" + w + "' is out of range for " + TypeName(type);
+  const int r = ccomm_parse_element(type, w.c_str(), out);
+  if (r == 0) return true;
+  if (!ccomm_type_name(type)) *error = "unknown type";
+  else if (r == CCOMM_E_TYPE) *error = "'" + w + "' is out of range for " + TypeName(type);
   else if (type == CCOMM_BOOL) *error = "'" + w + "' is not a bool (0, 1, true, false)";
   else *error = "'" + w + "' is not a valid " + TypeName(type);
   return false;
 }
 
 bool LooksLikeNumber(const char* word) {
-  using config_detail::NumResult;
   uint8_t v[8];
-  return config_detail::ParseValueElement(ValueType::kDouble, word, v) != NumResult::kSyntax ||
-         config_detail::ParseValueElement(ValueType::kInt64, word, v) != NumResult::kSyntax;  // -0x10
+  return ccomm_parse_element(CCOMM_DOUBLE, word, v) != CCOMM_E_INVAL ||
+         ccomm_parse_element(CCOMM_INT64, word, v) != CCOMM_E_INVAL;  // -0x10
 }
 
 bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error) {

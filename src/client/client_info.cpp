@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "ccomm/ccomm.h"
+#include "common/value_text.h"
 #include "client/client_internal.h"
 #include "client/sized_struct.h"
 #include "common/platform.h"
@@ -84,6 +85,13 @@ int ccomm_describe_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_des
 // The plain symbols (parenthesised: ccomm.h makes the names macros of the *_sized calls).
 int(ccomm_describe)(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
   return ccomm_describe_sized(c, s, out, sizeof(ccomm_signal_desc));
+}
+
+int ccomm_parse_element(int32_t type, const char* text, void* out) {
+  if (!text || !out || !ccomm_type_name(type)) return CCOMM_E_INVAL;
+  using ccomm::value_text::NumResult;
+  const NumResult r = ccomm::value_text::ParseValueElement(static_cast<ccomm::ValueType>(type), text, out);
+  return r == NumResult::kOk ? 0 : r == NumResult::kRange ? CCOMM_E_TYPE : CCOMM_E_INVAL;
 }
 
 const char* ccomm_type_name(int32_t type) {
@@ -179,6 +187,37 @@ int ccomm_get_peer_stats_sized(const ccomm_client* c, int node, ccomm_peer_stats
 
 int(ccomm_get_peer_stats)(const ccomm_client* c, int node, ccomm_peer_stats* out) {
   return ccomm_get_peer_stats_sized(c, node, out, sizeof(ccomm_peer_stats));
+}
+
+int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out) {
+  if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= SegmentOf(c).node_count()) return CCOMM_E_INVAL;
+  const st::PeerStats& ps = SegmentOf(c).peer(static_cast<uint32_t>(node));
+  *out = ccomm_peer_clock{};
+  // Known once a frame of it was received (the receive path stores the floor with it).
+  out->known = ps.frames_rx.load(std::memory_order_acquire) > 0 ? 1 : 0;
+  out->offset_floor_ns = static_cast<int64_t>(ps.clock_floor_ns.load(std::memory_order_relaxed));
+  out->queue_delay_ns = ps.queue_delay_ns.load(std::memory_order_relaxed);
+  out->queue_delay_max_ns = ps.queue_delay_max_ns.load(std::memory_order_relaxed);
+  out->frames_delayed = ps.frames_delayed.load(std::memory_order_relaxed);
+  return 0;
+}
+
+int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out) {
+  if (!c || !out) return CCOMM_E_INVAL;
+  const st::Segment& seg = SegmentOf(c);
+  const st::PeerStats& self = seg.peer(seg.node_id());
+  *out = ccomm_clock_state{};
+  const uint64_t word = self.clock_state.load(std::memory_order_acquire);
+  out->state = static_cast<int32_t>(word & 0xFF);
+  out->port_state = static_cast<int32_t>((word >> 8) & 0xFF);
+  out->offset_ns = static_cast<int64_t>(self.clock_offset_ns.load(std::memory_order_relaxed));
+  out->path_delay_ns = static_cast<int64_t>(self.clock_path_delay_ns.load(std::memory_order_relaxed));
+  return 0;
+}
+
+const char* ccomm_clock_state_name(int state) {
+  static const char* const kNames[] = {"none", "syncing", "synced", "lost"};
+  return state >= 0 && state < 4 ? kNames[state] : "?";
 }
 
 int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {

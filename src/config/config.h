@@ -106,12 +106,26 @@ struct Ros2Config {
   int line = 0;
 };
 
+// <clock>: linuxptp between the boards (local policy, not in the hash: a wrong domain shows
+// as a clock that never syncs, not as refused frames). Parsed by clock_section.cpp;
+// ccommd --clock-config writes ptp4l's configuration from it (daemon/ptp_config.cpp).
+struct ClockConfig {
+  bool present = false;
+  uint32_t domain = 0;                    // PTP domainNumber, 0..127
+  std::vector<std::string> grandmasters;  // nodes that may be grandmaster, best first; the rest are slave-only
+  bool hardware = false;                  // timestamping="hardware" (the NIC's clock + phc2sys), else software
+  int sync_interval_log = -3;             // logSyncInterval: Sync every 2^n s (-7..4)
+  std::string socket = "/var/run/ptp4l";  // ptp4l's management socket (uds_address), ccommd asks it
+  int line = 0;
+};
+
 struct SystemConfig {
   std::string path;            // file it was read from
   NetworkConfig network;
   std::vector<NodeConfig> nodes;
   std::vector<SignalConfig> signals;
   std::vector<Ros2Config> ros2;  // at most one per node
+  ClockConfig clock;             // <clock>, at most one
   uint32_t hash = 0;           // FNV-1a over a canonical form of what both ends must agree on
                                // (node names/order, signal name/type/count/kind/producer/
                                // consumers, ethertype, udp port); not whitespace or comments,

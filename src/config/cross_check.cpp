@@ -121,6 +121,7 @@ void Parser::CrossCheck(SystemConfig* cfg) {
     }
   }
   CrossCheckRos2(cfg);
+  CrossCheckClock(cfg);
 }
 
 }  // namespace config_detail

@@ -153,7 +153,7 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
   int nodes_seen = 0, signals_seen = 0;
   int node_elements = 0;
   for (const Node* c = root->first_node("node"); c; c = c->next_sibling("node")) ++node_elements;
-  const std::vector<std::string> kChildren = {"network", "node", "signal", "ros2"};
+  const std::vector<std::string> kChildren = {"network", "node", "signal", "ros2", "clock"};
   for (const Node* c = root->first_node(); c; c = c->next_sibling()) {
     if (c->type() != rapidxml::node_element) continue;
     std::string_view name = NameOf(c);
@@ -185,9 +185,15 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
       Ros2Config r;
       Ros2Element(c, &r);
       cfg->ros2.push_back(std::move(r));
+    } else if (name == "clock") {
+      if (cfg->clock.present) {
+        Err(line, "second <clock> (first at line " + std::to_string(cfg->clock.line) + ")");
+        continue;
+      }
+      ClockElement(c, &cfg->clock);
     } else {
       std::string hint = Suggest(name, kChildren);
-      if (hint.empty()) hint = " (expected network, node, signal or ros2)";
+      if (hint.empty()) hint = " (expected network, node, signal, ros2 or clock)";
       Err(line, "unknown element <" + std::string(name) + "> in <ccomm>" + hint);
     }
   }

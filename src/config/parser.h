@@ -140,6 +140,8 @@ class Parser {
   void CrossCheck(SystemConfig* cfg);
   void Ros2Element(const Node* n, Ros2Config* out);     // ros2_section.cpp
   void CrossCheckRos2(SystemConfig* cfg);               // ros2_section.cpp
+  void ClockElement(const Node* n, ClockConfig* out);   // clock_section.cpp
+  void CrossCheckClock(SystemConfig* cfg);              // clock_section.cpp
 
   bool Name(const Element& e, const char* what, std::string* out);
   template <typename T>

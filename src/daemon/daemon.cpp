@@ -24,6 +24,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   cfg_ = &cfg;
   self_ = node_id;
   opt_ = opt;
+  ptp_.Configure(opt.ptp_socket, opt.ptp_synced_within_ns, static_cast<uint8_t>(cfg.clock.domain));
   const NodeConfig& self = cfg.nodes[node_id];
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   heartbeat_ns_ = uint64_t{cfg.network.heartbeat_ms} * 1000000;
@@ -218,6 +219,7 @@ void Daemon::Supervise(uint64_t now) {
           cfg_->network.peer_timeout_ms);
     }
   }
+  SuperviseClock(now);
   view_.Tick(now);  // this node's summary, rate-limited (system_view.h)
   for (uint32_t id : consumed_) {
     const SignalConfig& s = cfg_->signals[id];

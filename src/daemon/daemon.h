@@ -13,6 +13,8 @@
 #include "config/config.h"
 #include "daemon/auth.h"
 #include "daemon/foreign_frames.h"
+#include "daemon/peer_clock.h"
+#include "daemon/ptp_state.h"
 #include "daemon/system_view.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
@@ -31,6 +33,10 @@ struct DaemonOptions {
   bool no_realtime = false;    // --no-rt: skip mlockall / SCHED_FIFO (tests, unprivileged)
   int verbosity = 6;           // LogLevel
   int recv_timeout_ms = 50;
+  std::string ptp_socket = "/var/run/ptp4l";  // --ptp-socket; empty: not asked (ptp_state.h)
+  bool ptp_socket_given = false;               // --ptp-socket given: <clock socket=> does not apply
+  bool clock_config = false;                   // --clock-config: print ptp4l.conf for the node, exit
+  int64_t ptp_synced_within_ns = 1000000;      // |offset from master| of a synced slave
 };
 
 class Daemon {
@@ -46,6 +52,7 @@ class Daemon {
   void RunRx();   // receive thread body
   /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call every ~10 ms.
   void Supervise(uint64_t now_ns);
+  void SuperviseClock(uint64_t now_ns);  // ptp_state.h, published in ptp_clock.cpp
   void RequestStop();
   /// Detaches from the segment (which stays for the clients: their values go stale).
   void Shutdown();
@@ -82,6 +89,7 @@ class Daemon {
     FrameStream stream[2];      // [0]: frames addressed to us, [1]: broadcast
     uint64_t last_rx_ns = 0;    // our clock at its last accepted frame (receive thread only)
     uint32_t ipv4 = 0;          // UDP: the configured source address (network order); 0 = any
+    PeerClock clock;            // its clock's offset floor: frames' queueing delays (peer_clock.h)
   };
   // Receiver rule 6: a signal's last applied value. The wire carries 32-bit sequence
   // numbers; `ext` extends them to 64 bits (serial arithmetic), so readers see a number
@@ -184,6 +192,7 @@ class Daemon {
   std::vector<uint32_t> senders_;                 // indices of peers_tx_ that send
   uint32_t group_tx_ = 0;                         // index of the group stream (multicast fan-out)
   bool fanout_multicast_ = false;
+  ptp::Monitor ptp_;              // this board's clock state (supervision thread)
   std::vector<PeerRx> peers_rx_;
   std::vector<std::vector<uint32_t>> consumers_;  // signal -> the streams (peers_tx_) it goes out on
   std::vector<uint32_t> periodic_;                // forwarded periodic signal ids

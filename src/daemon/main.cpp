@@ -18,6 +18,7 @@
 #include "daemon/daemon.h"
 #include "daemon/node_identity.h"
 #include "daemon/privileges.h"
+#include "daemon/ptp_config.h"
 #include "daemon/sd_notify.h"
 #include "daemon/segment_builder.h"
 #include "store/layout.h"
@@ -44,6 +45,10 @@ const char kUsage[] =
     "                        signals, types, hash, ros2) for tools; docs/config.md\n"
     "      --transport udp   use UDP for every node, whatever the file says (no root needed)\n"
     "      --no-rt           skip mlockall and SCHED_FIFO (tests, unprivileged runs)\n"
+    "      --ptp-socket PATH ptp4l's management socket, asked for the clock state once a\n"
+    "                        second (default: <clock socket=>, else /var/run/ptp4l; 'none':\n"
+    "                        not asked, state none)\n"
+    "      --clock-config    print ptp4l's configuration for this node from <clock>; exit\n"
     "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
     "  -q, --quiet           warnings and errors only\n"
     "  -h, --help            this text\n"
@@ -79,7 +84,9 @@ int main(int argc, char** argv) {
       {"no-rt", no_argument, nullptr, 'R'},        {"verbose", no_argument, nullptr, 'v'},
       {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
       {"version", no_argument, nullptr, 'V'},      {"which-node", no_argument, nullptr, 'W'},
-      {"json", no_argument, nullptr, 'J'},         {nullptr, 0, nullptr, 0}};
+      {"json", no_argument, nullptr, 'J'},
+      {"ptp-socket", required_argument, nullptr, 'P'}, {"clock-config", no_argument, nullptr, 'K'},
+      {nullptr, 0, nullptr, 0}};
   bool json = false;
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
@@ -99,6 +106,11 @@ int main(int argc, char** argv) {
         }
         break;
       case 'R': opt.no_realtime = true; break;
+      case 'P':
+        opt.ptp_socket = strcmp(optarg, "none") == 0 ? "" : optarg;
+        opt.ptp_socket_given = true;
+        break;
+      case 'K': opt.clock_config = true; break;
       case 'W': opt.which_node = true; break;
       case 'J': json = true; break;
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
@@ -169,6 +181,17 @@ int main(int argc, char** argv) {
     printf("%s (%s)\n", cfg.nodes[static_cast<size_t>(node)].name.c_str(), how.c_str());
     return 0;
   }
+  if (opt.clock_config) {
+    const std::string text = Ptp4lConfig(cfg, static_cast<uint32_t>(node), &error);
+    if (text.empty()) {
+      fprintf(stderr, "ccommd: %s\n", error.c_str());
+      return 1;
+    }
+    fputs(text.c_str(), stdout);
+    return 0;
+  }
+  // <clock socket=> names ptp4l's socket unless --ptp-socket did.
+  if (!opt.ptp_socket_given && cfg.clock.present) opt.ptp_socket = cfg.clock.socket;
   opt.node = cfg.nodes[static_cast<size_t>(node)].name;
   Log(LogLevel::kInfo, "this board is node '%s' (%s)", opt.node.c_str(), how.c_str());
 

@@ -59,6 +59,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
     for (size_t i = 0; i < rx_signals_.size(); ++i)
       if (cfg_->signals[i].producer == h.sender) rx_signals_[i].last.seen = false;
     ResetReassemblers(h.sender);
+    pr.clock.Reset();  // a rebooted peer's clock starts again: its offset floor is void
     fs.last_send_ns = h.send_time_ns;
   }
   fs.behind = 0;
@@ -219,6 +220,10 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   ps.last_seq.store(h.seq, std::memory_order_relaxed);
   ps.last_rx_ns.store(now, std::memory_order_release);
   ps.last_latency_ns.store(now - h.send_time_ns, std::memory_order_relaxed);
+  // Its values count as arrived when the frame would have without the queueing it met
+  // (peer_clock.h): a frame held seconds in our socket does not make its values fresh.
+  const uint64_t arrived = now - ClampedQueueDelay(pr.clock.Observe(h.send_time_ns, now), now);
+  AccountQueueDelay(ps, pr.clock, now - arrived);
   if (!ps.alive.exchange(1, std::memory_order_acq_rel))
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
   if (h.flags & wire::kFlagHeartbeat) ps.heartbeats_rx.fetch_add(1, std::memory_order_relaxed);
@@ -239,18 +244,18 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   uint32_t i = 0;
   for (; i < known; ++i) {
     RxSignal& rs = signals[wire::EntryRef{p}.signal()];  // < signal_count: rx_known_ is as long
-    if (rs.producer == sender) stored |= ApplyEntry(rs, p, now);
-    else stored |= HandleOtherEntry(h, p, now);
+    if (rs.producer == sender) stored |= ApplyEntry(rs, p, arrived);
+    else stored |= HandleOtherEntry(h, p, arrived);
     p += rs.entry_size;
   }
   for (; i < entry_count; ++i) {
     const wire::EntryRef e{p};
     const uint16_t id = e.signal();
     if (id < signal_count && signals[id].prefix == e.prefix() && signals[id].producer == sender) {
-      stored |= ApplyEntry(signals[id], p, now);
+      stored |= ApplyEntry(signals[id], p, arrived);
       p += signals[id].entry_size;
     } else {
-      stored |= HandleOtherEntry(h, p, now);
+      stored |= HandleOtherEntry(h, p, arrived);
       p = e.next().p;
     }
   }

@@ -34,8 +34,8 @@ int CcommTypeOf(FmiType t) {
   }
 }
 const char* CcommTypeName(int t) {
-  static const char* const kNames[] = {"?", "bool", "int32", "uint32", "int64", "float", "double"};
-  return t >= 1 && t <= 6 ? kNames[t] : "?";
+  const char* name = ccomm_type_name(static_cast<int32_t>(t));
+  return name ? name : "?";
 }
 int64_t Now() {
   timespec ts;

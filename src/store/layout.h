@@ -195,7 +195,18 @@ struct alignas(kCacheLine) PeerStats {
   std::atomic<uint32_t> alive;            // 1 while heartbeats arrive within peer_timeout_ms
   std::atomic<uint32_t> last_seq;
   std::atomic<uint64_t> last_latency_ns;  // last frame's (arrival - send time); same-clock setups only
+  // Its clock as the receive path bounds it from its frames (daemon/peer_clock.h); these
+  // fill what was padding, so the size and every offset stay as in layout 6.
+  std::atomic<uint64_t> clock_floor_ns;     // int64: min(arrival - send) over the window
+  std::atomic<uint64_t> frames_delayed;     // frames held >= 10 ms beyond that floor
+  std::atomic<uint64_t> queue_delay_ns;     // the last frame's delay beyond the floor
+  std::atomic<uint64_t> queue_delay_max_ns; // the largest so far
+  // This node's own entry only: its clock synchronisation (daemon/ptp_state.h).
+  std::atomic<uint64_t> clock_state;        // ClockState | PTP port state << 8 | 1 << 16 once published
+  std::atomic<uint64_t> clock_offset_ns;    // int64: ptp4l's offset from its master
+  std::atomic<uint64_t> clock_path_delay_ns;  // int64: ptp4l's mean path delay (P2P)
 };
+static_assert(sizeof(PeerStats) == 2 * kCacheLine, "PeerStats keeps layout 6's size");
 
 inline constexpr size_t AlignUp(size_t v, size_t a) { return (v + a - 1) & ~(a - 1); }
 

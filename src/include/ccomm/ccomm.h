@@ -97,6 +97,13 @@ typedef enum ccomm_type {
 CCOMM_API const char* ccomm_type_name(int32_t type);
 /** Bytes of one element of a ccomm_type (bool: 1); 0 for another value. */
 CCOMM_API uint32_t ccomm_type_size(int32_t type);
+/** Reads one element of a value of type `type` from `text` exactly as signals.xml reads a
+ *  safe_value: bool true/false/1/0; integers in decimal or 0x hex, '-' only for signed
+ *  types, no '+'; float and double in C syntax, inf and nan included. Writes
+ *  ccomm_type_size(type) bytes to `out`. Returns 0, CCOMM_E_INVAL (not a number of that
+ *  type, or an unknown type) or CCOMM_E_TYPE (a number that does not fit the type: a float
+ *  that would become inf or 0 is refused, never rounded). For tools (ccomm pub), not [rt]. */
+CCOMM_API int ccomm_parse_element(int32_t type, const char* text, void* out);
 /** The ccomm_type called `name` ("double"), or CCOMM_E_INVAL. */
 CCOMM_API int ccomm_type_from_name(const char* name);
 
@@ -296,6 +303,49 @@ typedef struct ccomm_peer_stats {
 CCOMM_API int ccomm_get_peer_stats(const ccomm_client* c, int node, ccomm_peer_stats* out);
 CCOMM_API int ccomm_get_peer_stats_sized(const ccomm_client* c, int node, ccomm_peer_stats* out, size_t size);
 #define ccomm_get_peer_stats(c, node, out) ccomm_get_peer_stats_sized((c), (node), (out), sizeof(*(out)))
+
+/**
+ * A peer's clock as this node's ccommd bounds it from the peer's frames alone (no clock
+ * synchronisation needed; docs/design.md, "Time"). Each frame's arrival minus its send
+ * time (the peer's CLOCK_MONOTONIC) is this node's clock minus the peer's plus the
+ * frame's delay; the smallest over the last 2-4 s (`offset_floor_ns`) stands for the
+ * path's fastest delay, and whatever a frame took beyond it is its queueing delay. A
+ * value's age (ccomm_info.age_ns) includes its frame's queueing delay, so a frame that
+ * waited seconds in a queue (a stopped ccommd, a full socket) does not read as fresh.
+ * The age is then exact to within the fastest one-way delay of the window (too young by
+ * at most that) plus the clocks' drift over the window (at most rho * 4 s, rho the
+ * boards' relative frequency error).
+ */
+typedef struct ccomm_peer_clock {
+  int32_t known;                /**< 1 once a frame arrived from it (the rest is valid) */
+  int32_t reserved;             /**< 0 */
+  int64_t offset_floor_ns;      /**< min(arrival - send time) over the window */
+  uint64_t queue_delay_ns;      /**< the last frame's delay beyond that floor */
+  uint64_t queue_delay_max_ns;  /**< the largest such delay since ccommd created the segment */
+  uint64_t frames_delayed;      /**< frames held >= 10 ms beyond the floor (their values aged by it) */
+} ccomm_peer_clock;
+/** Fills `out` for node `node` (known = 0 for this node itself); CCOMM_E_INVAL for a bad
+ *  handle or node index. */
+CCOMM_API int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out);
+
+/** This board's clock synchronisation, as ccommd reads it from linuxptp's ptp4l once a second. */
+typedef enum ccomm_clock_state_code {
+  CCOMM_CLOCK_NONE = 0,    /**< no ptp4l answers (none running, or ccommd --ptp-socket none): ages are local */
+  CCOMM_CLOCK_SYNCING = 1, /**< ptp4l runs; its port is not (yet) a slave within the threshold, nor grandmaster */
+  CCOMM_CLOCK_SYNCED = 2,  /**< slave with |offset from master| <= 1 ms, or the grandmaster itself */
+  CCOMM_CLOCK_LOST = 3     /**< ptp4l answered before and stopped (killed, hung), or its port is faulty */
+} ccomm_clock_state_code;
+typedef struct ccomm_clock_state {
+  int32_t state;            /**< ccomm_clock_state_code; CCOMM_CLOCK_NONE also when ccommd never ran */
+  int32_t port_state;       /**< IEEE 1588 portState of ptp4l's port (9 slave, 6 master, 8 uncalibrated,
+                                 4 listening, 2 faulty...); 0 unknown */
+  int64_t offset_ns;        /**< ptp4l's last offset from its master (TIME_STATUS_NP master_offset) */
+  int64_t path_delay_ns;    /**< its peer mean path delay (P2P delay mechanism; 0 with E2E) */
+} ccomm_clock_state;
+/** Fills `out`; CCOMM_E_INVAL for a bad handle. */
+CCOMM_API int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out);
+/** "none", "syncing", "synced", "lost" (or "?"). */
+CCOMM_API const char* ccomm_clock_state_name(int state);
 
 /**
  * Daemon-wide counter `index` (0, 1, ... until CCOMM_E_INVAL): its name (e.g.

@@ -20,7 +20,7 @@ from __future__ import annotations
 import struct
 from typing import Tuple
 
-from ..client import SignalInfo
+from ..client import SignalInfo, SignalType
 from .schema import MessageEncoder
 
 PROFILE = "ros2"
@@ -31,12 +31,12 @@ _CDR_LE = b"\x00\x01\x00\x00"  # encapsulation: plain CDR, little-endian
 
 # ccomm type -> (scalar message, array message, ROS 2 primitive, element size)
 _TYPES = {
-    "double": ("Float64", "Float64MultiArray", "float64", 8),
-    "float": ("Float32", "Float32MultiArray", "float32", 4),
-    "int32": ("Int32", "Int32MultiArray", "int32", 4),
-    "uint32": ("UInt32", "UInt32MultiArray", "uint32", 4),
-    "int64": ("Int64", "Int64MultiArray", "int64", 8),
-    "bool": ("Bool", "UInt8MultiArray", "bool", 1),
+    SignalType.DOUBLE: ("Float64", "Float64MultiArray", "float64", 8),
+    SignalType.FLOAT: ("Float32", "Float32MultiArray", "float32", 4),
+    SignalType.INT32: ("Int32", "Int32MultiArray", "int32", 4),
+    SignalType.UINT32: ("UInt32", "UInt32MultiArray", "uint32", 4),
+    SignalType.INT64: ("Int64", "Int64MultiArray", "int64", 8),
+    SignalType.BOOL: ("Bool", "UInt8MultiArray", "bool", 1),
 }
 _SEPARATOR = "=" * 80 + "\n"
 _LAYOUT = ("MSG: std_msgs/MultiArrayLayout\n"
@@ -50,7 +50,7 @@ _DIMENSION = ("MSG: std_msgs/MultiArrayDimension\n"
 
 def ros_type(desc: SignalInfo) -> str:
     """The std_msgs type of a signal, as ROS 2 names it ("std_msgs/msg/Float64")."""
-    scalar, array, _, _ = _TYPES[desc.type_name]
+    scalar, array, _, _ = _TYPES[desc.type]
     return "std_msgs/msg/" + (array if desc.count > 1 else scalar)
 
 
@@ -60,10 +60,10 @@ def topic(desc: SignalInfo, namespace: str = DEFAULT_NAMESPACE) -> str:
 
 def definition(desc: SignalInfo) -> bytes:
     """The message definition in rosbag2's concatenated .msg form."""
-    _, _, primitive, _ = _TYPES[desc.type_name]
+    _, _, primitive, _ = _TYPES[desc.type]
     if desc.count == 1:
         return (primitive + " data\n").encode()
-    element = "uint8" if desc.type_name == "bool" else primitive
+    element = "uint8" if desc.type == SignalType.BOOL else primitive
     return ("MultiArrayLayout layout\n" + element + "[] data\n" +
             _SEPARATOR + _LAYOUT + _SEPARATOR + _DIMENSION).encode()
 
@@ -76,7 +76,7 @@ def message_encoder(desc: SignalInfo) -> Tuple[None, MessageEncoder]:
     """(None, encode) with the json profile's encoder signature: the CDR message of one
     value. The value bytes ccomm stores are already the little-endian elements CDR wants,
     so a message is a constant prefix and the value's bytes."""
-    _, _, _, size = _TYPES[desc.type_name]
+    _, _, _, size = _TYPES[desc.type]
     n = desc.value_bytes
     if desc.count == 1:
         prefix = _CDR_LE

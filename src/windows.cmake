@@ -10,8 +10,9 @@ ccomm_core_target(ccomm_store)
 target_link_libraries(ccomm_store PUBLIC ccomm_platform)
 
 set(_cfg ${CMAKE_CURRENT_LIST_DIR}/config)
-add_library(ccomm_config STATIC ${_cfg}/config.cpp ${_cfg}/xml_input.cpp ${_cfg}/text.cpp ${_cfg}/parser.cpp
-            ${_cfg}/parser_signal.cpp ${_cfg}/cross_check.cpp ${_cfg}/ros2_section.cpp)
+include(${_cfg}/sources.cmake)
+list(TRANSFORM CCOMM_CONFIG_SOURCES PREPEND ${_cfg}/)
+add_library(ccomm_config STATIC ${CCOMM_CONFIG_SOURCES})
 ccomm_core_target(ccomm_config)
 target_link_libraries(ccomm_config PUBLIC ccomm_platform)
 # The build machine's /usr/include holds RapidXML: searched after MinGW's own headers.

@@ -137,6 +137,10 @@ elif name == "plain ccomm_get_signal_stats":  # the symbol programs built agains
     r = L.ccomm_get_signal_stats(h, d, p)
 elif name == "ccomm_peer_stats":
     r = L.ccomm_get_peer_stats_sized(h, 0, p, size)
+elif name == "ccomm_peer_clock":
+    r = L.ccomm_get_peer_clock_sized(h, 0, p, size)
+elif name == "ccomm_clock_state":
+    r = L.ccomm_get_clock_state_sized(h, p, size)
 else:
     v = ctypes.c_void_p()
     assert L.ccomm_view_open(h, ctypes.byref(v)) == 0

@@ -189,7 +189,7 @@ int(ccomm_get_peer_stats)(const ccomm_client* c, int node, ccomm_peer_stats* out
   return ccomm_get_peer_stats_sized(c, node, out, sizeof(ccomm_peer_stats));
 }
 
-int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out) {
+static int FillPeerClock(const ccomm_client* c, int node, ccomm_peer_clock* out) {
   if (!c || !out || node < 0 || static_cast<uint32_t>(node) >= SegmentOf(c).node_count()) return CCOMM_E_INVAL;
   const st::PeerStats& ps = SegmentOf(c).peer(static_cast<uint32_t>(node));
   *out = ccomm_peer_clock{};
@@ -202,7 +202,7 @@ int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out)
   return 0;
 }
 
-int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out) {
+static int FillClockState(const ccomm_client* c, ccomm_clock_state* out) {
   if (!c || !out) return CCOMM_E_INVAL;
   const st::Segment& seg = SegmentOf(c);
   const st::PeerStats& self = seg.peer(seg.node_id());
@@ -213,6 +213,16 @@ int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out) {
   out->offset_ns = static_cast<int64_t>(self.clock_offset_ns.load(std::memory_order_relaxed));
   out->path_delay_ns = static_cast<int64_t>(self.clock_path_delay_ns.load(std::memory_order_relaxed));
   return 0;
+}
+
+int ccomm_get_peer_clock_sized(const ccomm_client* c, int node, ccomm_peer_clock* out, size_t size) {
+  ccomm_peer_clock pc{};
+  return CopySized(FillPeerClock(c, node, &pc), pc, out, size);
+}
+
+int ccomm_get_clock_state_sized(const ccomm_client* c, ccomm_clock_state* out, size_t size) {
+  ccomm_clock_state cs{};
+  return CopySized(FillClockState(c, &cs), cs, out, size);
 }
 
 const char* ccomm_clock_state_name(int state) {

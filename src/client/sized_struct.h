@@ -19,6 +19,8 @@ template <> struct FirstSize<ccomm_peer_stats> { static constexpr size_t value =
 template <> struct FirstSize<ccomm_view_node> { static constexpr size_t value = 112; };
 template <> struct FirstSize<ccomm_view_signal> { static constexpr size_t value = 40; };
 template <> struct FirstSize<ccomm_view_counters> { static constexpr size_t value = 48; };
+template <> struct FirstSize<ccomm_peer_clock> { static constexpr size_t value = 40; };
+template <> struct FirstSize<ccomm_clock_state> { static constexpr size_t value = 24; };
 
 // Copies `full` into the caller's `size` bytes at `out`: the first min(size, sizeof)
 // bytes, zeros beyond (a caller built against a newer header). CCOMM_E_INVAL for a

@@ -80,6 +80,26 @@ class PeerStats(ctypes.Structure):  # ccomm_peer_stats
     ]
 
 
+class PeerClock(ctypes.Structure):  # ccomm_peer_clock
+    _fields_ = [
+        ("known", ctypes.c_int32),
+        ("reserved", ctypes.c_int32),
+        ("offset_floor_ns", ctypes.c_int64),
+        ("queue_delay_ns", ctypes.c_uint64),
+        ("queue_delay_max_ns", ctypes.c_uint64),
+        ("frames_delayed", ctypes.c_uint64),
+    ]
+
+
+class ClockState(ctypes.Structure):  # ccomm_clock_state
+    _fields_ = [
+        ("state", ctypes.c_int32),
+        ("port_state", ctypes.c_int32),
+        ("offset_ns", ctypes.c_int64),
+        ("path_delay_ns", ctypes.c_int64),
+    ]
+
+
 class SignalDesc(ctypes.Structure):
     _fields_ = [
         ("name", ctypes.c_char_p),
@@ -142,6 +162,7 @@ class ViewCounters(ctypes.Structure):
 # The public structs of ccomm.h by their C name: what the layout test compares.
 STRUCTS: Dict[str, Type[ctypes.Structure]] = {
     "ccomm_info": Info, "ccomm_signal_desc": SignalDesc, "ccomm_history_cursor": HistoryCursor,
+    "ccomm_peer_clock": PeerClock, "ccomm_clock_state": ClockState,
     "ccomm_history_info": HistoryInfo, "ccomm_signal_stats": SignalStats,
     "ccomm_peer_stats": PeerStats, "ccomm_view_node": ViewNode,
     "ccomm_view_signal": ViewSignal, "ccomm_view_counters": ViewCounters,
@@ -287,6 +308,8 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),
         "ccomm_node_count": ([vp], c_int),
         "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
+        "ccomm_get_peer_clock_sized": ([vp, c_int, vp, sz], c_int),
+        "ccomm_get_clock_state_sized": ([vp, vp, sz], c_int),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
         "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),

@@ -108,8 +108,8 @@ CCOMM_API int ccomm_parse_element(int32_t type, const char* text, void* out);
 CCOMM_API int ccomm_type_from_name(const char* name);
 
 /*
- * Growable structs. ccomm_signal_desc, ccomm_signal_stats, ccomm_peer_stats and the
- * ccomm_view_* structs gain fields only at their end. The calls that fill them take the
+ * Growable structs. ccomm_signal_desc, ccomm_signal_stats, ccomm_peer_stats,
+ * ccomm_peer_clock, ccomm_clock_state and the ccomm_view_* structs gain fields only at their end. The calls that fill them take the
  * caller's sizeof (the *_sized entry points; the plain names below are macros passing
  * sizeof(*out)): the library fills that many bytes and zeroes any it has no field for, so
  * a program keeps working against a newer library (and a newer one against an older).
@@ -325,8 +325,9 @@ typedef struct ccomm_peer_clock {
   uint64_t frames_delayed;      /**< frames held >= 10 ms beyond the floor (their values aged by it) */
 } ccomm_peer_clock;
 /** Fills `out` for node `node` (known = 0 for this node itself); CCOMM_E_INVAL for a bad
- *  handle or node index. */
-CCOMM_API int ccomm_get_peer_clock(const ccomm_client* c, int node, ccomm_peer_clock* out);
+ *  handle or node index. Growable (see "Growable structs"). */
+CCOMM_API int ccomm_get_peer_clock_sized(const ccomm_client* c, int node, ccomm_peer_clock* out, size_t size);
+#define ccomm_get_peer_clock(c, node, out) ccomm_get_peer_clock_sized((c), (node), (out), sizeof(*(out)))
 
 /** This board's clock synchronisation, as ccommd reads it from linuxptp's ptp4l once a second. */
 typedef enum ccomm_clock_state_code {
@@ -342,8 +343,9 @@ typedef struct ccomm_clock_state {
   int64_t offset_ns;        /**< ptp4l's last offset from its master (TIME_STATUS_NP master_offset) */
   int64_t path_delay_ns;    /**< its peer mean path delay (P2P delay mechanism; 0 with E2E) */
 } ccomm_clock_state;
-/** Fills `out`; CCOMM_E_INVAL for a bad handle. */
-CCOMM_API int ccomm_get_clock_state(const ccomm_client* c, ccomm_clock_state* out);
+/** Fills `out`; CCOMM_E_INVAL for a bad handle. Growable (see "Growable structs"). */
+CCOMM_API int ccomm_get_clock_state_sized(const ccomm_client* c, ccomm_clock_state* out, size_t size);
+#define ccomm_get_clock_state(c, out) ccomm_get_clock_state_sized((c), (out), sizeof(*(out)))
 /** "none", "syncing", "synced", "lost" (or "?"). */
 CCOMM_API const char* ccomm_clock_state_name(int state);
 

@@ -7,6 +7,7 @@ leave their data in ctx.cost); RUNNERS maps a kind to its runner."""
 
 import dataclasses
 import os
+import resource
 import shutil
 import time
 
@@ -166,6 +167,7 @@ def run_pair(ctx, case):
         sa = os.path.join(ctx.workdir, case.name + ".a.samples")
         sb = os.path.join(ctx.workdir, case.name + ".b.samples")
         before = _snapshot(d, names)
+        cpu0 = _cpu_mark(d, names)
         if o["mode"] == "ping":
             apps = [("b", _app(ctx, d, "b", names[1], rate, dur + 0.6, case.name + "-echo", sb, mode="echo"), 0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name, sa, mode="ping"), 0.3)]
@@ -176,12 +178,18 @@ def run_pair(ctx, case):
                      0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name + "-src", sa, warmup=warm), lead)]
         res = ccomm.run_apps(d, apps, dur + 30)
+        cpu_ns = _cpu_since(d, names, cpu0)
         after = _snapshot(d, names)
     dirn = ccomm.delta_stats(before, after, names[0], names[1])
     extra = dict(style=o["style"], signals=k, elements=count, signal_kind="state", wire=dirn, sent=res["a"]["sent"],
                  frames_per_cycle=_ratio(dirn["data_frames"], res["a"]["sent"]),
                  command=res["b"]["argv"] if o["mode"] == "oneway" else res["a"]["argv"],
                  daemon_command=d.argv[names[0]])
+    # CPU per value (issue 30, like the peers' rows): both applications' whole lives and both
+    # ccommds over the same time, per value delivered (a round trip delivers two).
+    values = (res["a"].get("sent") or 0) * (2 if o["mode"] == "ping" else 1)
+    if cpu_ns is not None and values:
+        extra.update(cpu_ns=cpu_ns, values=values, cpu_ns_per_value=round(cpu_ns / float(values)))
     if o["mode"] == "ping":
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["a"], sa, ctx.rawdir,
                                 metric="rtt_half", **extra)
@@ -189,6 +197,50 @@ def run_pair(ctx, case):
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["b"], sb, ctx.rawdir,
                                 **extra)
     return [row]
+
+
+def _cpu_mark(d, names):
+    """CPU time so far of the waited-for children (the applications, once they exit) and
+    of each ccommd's threads (schedstat ns)."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    daemons = {n: (d.cpu(n) or (0, 0))[1] for n in names}
+    return (ru.ru_utime + ru.ru_stime) * 1e9, daemons
+
+
+def _cpu_since(d, names, mark):
+    """ns of CPU used since _cpu_mark() by the applications run in between (utime+stime
+    of every waited-for child) and by both ccommds; None if a daemon could not be read."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    apps = (ru.ru_utime + ru.ru_stime) * 1e9 - mark[0]
+    total = apps
+    for n in names:
+        c = d.cpu(n)
+        if c is None:
+            return None
+        total += c[1] - mark[1][n]
+    return int(total)
+
+
+def run_throughput(ctx, case):
+    """8 B one way (one state signal, event-driven sends) at rising rates until the
+    receiving application misses a value: the last rate without loss."""
+    steps, best = [], None
+    for rate in (5000, 10000, 20000, 50000, 100000):
+        sub = dataclasses.replace(case, name="%s_%d" % (case.name, rate),
+                                  opts={"transport": case.opts["transport"], "signals": 1, "mode": "oneway",
+                                        "style": "block", "rate": rate})
+        row = run_pair(ctx, sub)[0]
+        steps.append({"offered_hz": rate, "received": row.get("count"), "lost": row.get("lost"),
+                      "p50_ns": row.get("p50_ns"), "cpu_ns_per_value": row.get("cpu_ns_per_value")})
+        if row.get("lost"):
+            break
+        best = row
+    best = dict(best or row)
+    best.update(name=case.name, throughput_steps=steps, metric="one_way",
+                values_per_s_lossfree=best["rate_hz"] if not best.get("lost") else 0)
+    lossy = [s for s in steps if s["lost"]]
+    best["values_per_s_at_loss"] = lossy[0]["offered_hz"] if lossy else None
+    return [best]
 
 
 def _ratio(a, b):
@@ -394,6 +446,6 @@ def run_callgrind_client(ctx, case):
     return []
 
 
-RUNNERS = {"large": large.run_large, "ccomm_local": run_local, "ccomm_pp": run_pingpong,
+RUNNERS = {"ccomm_tput": run_throughput, "large": large.run_large, "ccomm_local": run_local, "ccomm_pp": run_pingpong,
            "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle, "callgrind": run_callgrind,
            "callgrind_client": run_callgrind_client}

@@ -11,7 +11,7 @@ import resource
 import shutil
 import time
 
-from . import callgrind, ccomm, large, procs
+from . import callgrind, ccomm, large, peers, procs
 from .ccomm import Daemons, Failed, Skip
 
 # A spinning SCHED_FIFO thread is throttled after 0.95 s of every second
@@ -222,25 +222,16 @@ def _cpu_since(d, names, mark):
 
 
 def run_throughput(ctx, case):
-    """8 B one way (one state signal, event-driven sends) at rising rates until the
-    receiving application misses a value: the last rate without loss."""
-    steps, best = [], None
-    for rate in (5000, 10000, 20000, 50000, 100000):
+    """8 B one way (one state signal, sent as the application flushes) at the peers'
+    rising rates (peers.sweep) until the receiving application misses values."""
+    def measure(rate):
         sub = dataclasses.replace(case, name="%s_%d" % (case.name, rate),
                                   opts={"transport": case.opts["transport"], "signals": 1, "mode": "oneway",
                                         "style": "block", "rate": rate})
-        row = run_pair(ctx, sub)[0]
-        steps.append({"offered_hz": rate, "received": row.get("count"), "lost": row.get("lost"),
-                      "p50_ns": row.get("p50_ns"), "cpu_ns_per_value": row.get("cpu_ns_per_value")})
-        if row.get("lost"):
-            break
-        best = row
-    best = dict(best or row)
-    best.update(name=case.name, throughput_steps=steps, metric="one_way",
-                values_per_s_lossfree=best["rate_hz"] if not best.get("lost") else 0)
-    lossy = [s for s in steps if s["lost"]]
-    best["values_per_s_at_loss"] = lossy[0]["offered_hz"] if lossy else None
-    return [best]
+        return run_pair(ctx, sub)[0]
+    row = peers.sweep(measure, [r for r in peers.THROUGHPUT_RATES if r])
+    row["name"] = case.name
+    return [row]
 
 
 def _ratio(a, b):

@@ -151,7 +151,7 @@ def plan(smoke=False, rates=None, scale=1.0):
     # ---- today's peers (issue 30), beside the ccomm rows above: board to board Cyclone DDS
     # and Zenoh (one-way and RTT/2, 1 kHz and back to back, 8 / 288 B; throughput at 8 B
     # until loss), on one machine iceoryx2 (busy-poll and listener/notifier). peers.py.
-    for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("be", "rel"))):
+    for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("udp",))):
         for q in qoss:
             o = {"peer": peer, "reliable": q == "rel"}
             for p in (8, 288):

@@ -268,7 +268,9 @@ def checks(R, check):
             text = "peers (%s): ccomm %s below %s's (`%s` vs `%s`)" % (cls, what, pname.split("_")[0], cname, pname)
             if not pr or not cr or pr.get(key) is None or cr.get(key) is None:
                 miss = [n for n, r in ((pname, pr), (cname, cr)) if not r or r.get(key) is None]
-                out.append(check(text, None, "n/a (missing: %s)" % ", ".join("`%s`" % m for m in miss)))
+                ck = check(text, None, "n/a (missing: %s)" % ", ".join("`%s`" % m for m in miss))
+                ck["rows"] = (cname, pname, key)
+                out.append(ck)
                 continue
             ok = cr[key] < pr[key]
             detail = "ccomm %.2f µs vs %.2f µs (%.2fx)" % (cr[key] / 1e3, pr[key] / 1e3, cr[key] / float(pr[key]))

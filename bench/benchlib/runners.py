@@ -67,6 +67,7 @@ def run_pingpong(ctx, case):
         if o.get("interleave"):
             floor_shm = "/ccbench-floor-%d-%s" % (os.getpid(), case.name)
             exe += ["--floor-shm", floor_shm, "--block", "1000"]
+        cpu0 = _cpu_mark(d, [ccomm.LOCAL_NODE])
         echo = procs.start_background(exe + ["--role", "echo"] + ctx.side_opts("b"),
                                       os.path.join(ctx.workdir, case.name + ".echo.log"))
         try:
@@ -79,6 +80,12 @@ def run_pingpong(ctx, case):
             procs.forget(echo)
             if floor_shm and os.path.exists("/dev/shm" + floor_shm):
                 os.unlink("/dev/shm" + floor_shm)  # the ping removes it; not after a failure
+        cpu_ns = _cpu_since(d, [ccomm.LOCAL_NODE], cpu0)
+    # CPU per value (issue 30): both processes' whole lives and ccommd, per value handed over
+    # (two per round trip; interleaved floor blocks count too: they ran in the same processes).
+    trips = row["count"] + row["lost"] + 1000 + (row.get("floor_count") or 0)
+    if cpu_ns is not None:
+        row.update(cpu_ns, values=2 * trips, cpu_ns_per_value=round(cpu_ns["cpu_ns"] / (2.0 * trips)))
     row["raw"] = os.path.relpath(os.path.join(ctx.rawdir, case.name + ".tsv"), ctx.outdir)
     row.update(style=o["wait"], signal_kind=o["kind"], clock=o["clock"], command=argv)
     return [row]
@@ -189,7 +196,7 @@ def run_pair(ctx, case):
     # ccommds over the same time, per value delivered (a round trip delivers two).
     values = (res["a"].get("sent") or 0) * (2 if o["mode"] == "ping" else 1)
     if cpu_ns is not None and values:
-        extra.update(cpu_ns=cpu_ns, values=values, cpu_ns_per_value=round(cpu_ns / float(values)))
+        extra.update(cpu_ns, values=values, cpu_ns_per_value=round(cpu_ns["cpu_ns"] / float(values)))
     if o["mode"] == "ping":
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["a"], sa, ctx.rawdir,
                                 metric="rtt_half", **extra)
@@ -208,17 +215,18 @@ def _cpu_mark(d, names):
 
 
 def _cpu_since(d, names, mark):
-    """ns of CPU used since _cpu_mark() by the applications run in between (utime+stime
-    of every waited-for child) and by both ccommds; None if a daemon could not be read."""
+    """{"cpu_ns", "cpu_apps_ns", "cpu_daemons_ns"} used since _cpu_mark() by the
+    applications run in between (utime+stime of every waited-for child) and by the
+    ccommds; None if a daemon could not be read."""
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-    apps = (ru.ru_utime + ru.ru_stime) * 1e9 - mark[0]
-    total = apps
+    apps = int((ru.ru_utime + ru.ru_stime) * 1e9 - mark[0])
+    daemons = 0
     for n in names:
         c = d.cpu(n)
         if c is None:
             return None
-        total += c[1] - mark[1][n]
-    return int(total)
+        daemons += c[1] - mark[1][n]
+    return {"cpu_ns": apps + daemons, "cpu_apps_ns": apps, "cpu_daemons_ns": daemons}
 
 
 def run_throughput(ctx, case):
@@ -226,6 +234,7 @@ def run_throughput(ctx, case):
     rising rates (peers.sweep) until the receiving application misses values."""
     def measure(rate):
         sub = dataclasses.replace(case, name="%s_%d" % (case.name, rate),
+                                  seconds=max(case.seconds, case.opts["min_values"] / float(rate)),
                                   opts={"transport": case.opts["transport"], "signals": 1, "mode": "oneway",
                                         "style": "block", "rate": rate})
         return run_pair(ctx, sub)[0]

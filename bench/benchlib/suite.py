@@ -150,7 +150,8 @@ def plan(smoke=False, rates=None, scale=1.0):
 
     # ---- today's peers (issue 30), beside the ccomm rows above: board to board Cyclone DDS
     # and Zenoh (one-way and RTT/2, 1 kHz and back to back, 8 / 288 B; throughput at 8 B
-    # until loss), on one machine iceoryx2 (busy-poll and listener/notifier). peers.py.
+    # until loss, each step at least min_values values so the loss limit means something),
+    # on one machine iceoryx2 (busy-poll and listener/notifier). peers.py.
     for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("udp",))):
         for q in qoss:
             o = {"peer": peer, "reliable": q == "rel"}
@@ -162,10 +163,10 @@ def plan(smoke=False, rates=None, scale=1.0):
                 cases.append(Case("%s_%s_rtt_half_b2b_p%d" % (peer, q, p), "peer_net", "peers", n(5000, 300), p, 0,
                                   dict(o, role="rtt", half=True)))
             cases.append(Case("%s_%s_throughput_p8" % (peer, q), "peer_tput", "peers", 1000, 8, 0,
-                              dict(o, step_seconds=secs(0.5, 0.1))))
+                              dict(o, step_seconds=secs(0.5, 0.1), min_values=n(2000, 200))))
     for t in ("raw", "udp"):
         cases.append(CCase("ccomm_%s_throughput_p8" % t, "peers", "ccomm_tput", secs(0.5, 0.2),
-                           {"transport": t}))
+                           {"transport": t, "min_values": n(2000, 200)}))
     for wait in ("spin", "event"):
         for p in (8, 72, 288):
             cases.append(Case("iox2_%s_b2b_p%d" % (wait, p), "iox2", "peers", n(50000 if wait == "spin" else 10000,

@@ -313,8 +313,9 @@ def section(R, meta, problems):
                                   ", ".join(str(r) for r in THROUGHPUT_RATES), LOSS_LIMIT * 100))
     L.append("What CI covers: `scripts/bench --smoke` (the `bench` step of scripts/test) runs Cyclone DDS (one-way, "
              "reliable RTT/2, throughput) and ccomm's throughput sweep: `dds_pingpong` builds with the tree from "
-             "Debian's packages in seconds. The Rust peers run when `scripts/bench --peers rust` has built them "
-             "into the cache (or a build is already there): their cold builds (iceoryx2 0.10.0: 85 crates, "
+             "Debian's packages in seconds. The Rust peers are not in the smoke run; a full run measures them when "
+             "`scripts/bench --peers rust` has built them into the cache (or a build is already there): their cold "
+             "builds (iceoryx2 0.10.0: 85 crates, "
              "Zenoh 1.10.2 with only its UDP transport: 346) took tens of minutes on this 2-core machine, beyond "
              "CI's time. zenoh-pico is not measured: it is packaged neither by Debian 12 nor on crates.io, and "
              "this project builds nothing from a source checkout.\n")

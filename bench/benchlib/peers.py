@@ -143,7 +143,8 @@ def _rust_prog(ctx, peer):
         exe = rust_binary(peer)
         if not os.path.exists(exe):
             raise Skip("not built (a cold cargo build takes 10-60 min on 2 cores, more than CI has): "
-                       "`scripts/bench --peers rust` builds bench/peers/%s into %s" % (RUST_PEERS[peer][0], cache_dir()))
+                       "`scripts/bench --peers rust` builds bench/peers/%s into CCOMM_PEERS_CACHE (~/.cache/ccomm-peers)"
+                       % RUST_PEERS[peer][0])
         ctx.programs[key] = exe
     return ctx.programs[key]
 
@@ -335,8 +336,10 @@ def section(R, meta, problems):
         if r["name"] in seen or "throughput" in r["name"]:
             continue
         lines.append(["`%s`" % r["name"], "**%s**" % _us(r["p50_ns"]), _us(r["p99_ns"]), r["lost"],
-                      _us(r.get("cpu_ns_per_value")), "(no ccomm row of this kind: ccomm-latency sends periodically)",
-                      "-", "-"])
+                      _us(r.get("cpu_ns_per_value")),
+                      "(no ccomm row of this kind: ccomm_pingpong runs 8 and 288 B busy-polling, 8 B blocking)"
+                      if r["name"].startswith("iox2") else
+                      "(no ccomm row of this kind: ccomm-latency sends periodically, never back to back)", "-", "-"])
     if lines:
         L.append("| " + " | ".join(head) + " |")
         L.append("|" + "|".join(["---"] + ["---:"] * 4 + ["---", "---:", "---:"]) + "|")
@@ -374,6 +377,13 @@ def why(R, check):
                     "itself: in `%s` the write -> far ccommd has the frame part took p50 %s µs and far ccommd -> "
                     "application %s µs (ccomm-latency --stages), against %s µs for the whole of `%s`." % (
                         cname, _us(g.get("upstream_p50_ns")), _us(g.get("last_hop_p50_ns")), _us(p["p50_ns"]), pname))
+        if c.get("floor_p50_ns"):
+            return ("`%s` interleaved the bare shared-memory floor (one cache line handed over between the same two "
+                    "processes) in blocks of %s round trips: floor p50 %s µs, ccomm %s µs, so ccomm's own cost is "
+                    "%s µs; `%s` took %s µs, %s µs above that floor (measured minutes apart, in the same run)." % (
+                        cname, c.get("block"), _us(c["floor_p50_ns"]), _us(c["p50_ns"]),
+                        _us(c["p50_ns"] - c["floor_p50_ns"]), pname, _us(p["p50_ns"]),
+                        _us(p["p50_ns"] - c["floor_p50_ns"])))
         return ("`%s` has no stage timestamps (RTT/2 rows are not split); its one-way rows above are." % cname)
     if c.get("cpu_ns") is not None:
         v = float(c.get("values") or 1)

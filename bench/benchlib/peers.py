@@ -113,12 +113,14 @@ def _add_cpu(row, other):
 
 # ---- how each network peer is told where the other is ----
 
-def dds_config(peer_ip):
-    """CYCLONEDDS_URI: eth0 only, no multicast, discovery by unicast to the other
-    namespace: nothing leaves the veth pair, nothing of another run is seen."""
-    return ("<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"eth0\"/></Interfaces>"
+def dds_config(peer_ip, ifname="eth0", tag="ccbench"):
+    """CYCLONEDDS_URI: one interface, no multicast, discovery by unicast to the other
+    side and a discovery tag of this run: nothing leaves the veth pair, nothing of
+    another run (or another DDS user of the machine) is seen."""
+    return ("<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"%s\"/></Interfaces>"
             "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-            "<Peers><Peer address=\"%s\"/></Peers></Discovery></Domain></CycloneDDS>" % peer_ip)
+            "<Tag>%s</Tag><Peers><Peer address=\"%s\"/></Peers></Discovery></Domain></CycloneDDS>" % (
+                ifname, tag, peer_ip))
 
 
 def _net_argv(ctx, case, side):

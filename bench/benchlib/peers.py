@@ -319,8 +319,8 @@ def section(R, meta, problems):
              "Debian's packages in seconds. The Rust peers are not in the smoke run; a full run measures them when "
              "`scripts/bench --peers rust` has built them into the cache (or a build is already there): their cold "
              "builds (iceoryx2 0.10.0: 85 crates, "
-             "Zenoh 1.10.2 with only its UDP transport: 346) took tens of minutes on this 2-core machine, beyond "
-             "CI's time. zenoh-pico is not measured: it is packaged neither by Debian 12 nor on crates.io, and "
+             "Zenoh 1.10.2 with only its UDP transport: 346) took 22 and 25 minutes on this loaded 2-core machine "
+             "at nice 19, beyond CI's time. zenoh-pico is not measured: it is packaged neither by Debian 12 nor on crates.io, and "
              "this project builds nothing from a source checkout.\n")
     head = ["peer row", "p50 µs", "p99 µs †", "lost", "CPU/value µs", "ccomm row", "ccomm p50 µs",
             "ccomm CPU/value µs"]

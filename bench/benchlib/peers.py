@@ -349,7 +349,10 @@ def section(R, meta, problems):
         L.append("")
     tput = [r for r in R.rows if "throughput" in r["name"]]
     if tput:
-        L.append("Throughput at 8 B, one way (steps: offered values/s -> lost):\n")
+        L.append("Throughput at 8 B, one way (steps: offered values/s -> lost). Not like for like in one respect: "
+                 "Zenoh's default subscriber queues every sample (a FIFO channel), so a late receiver catches up; "
+                 "Cyclone DDS (keep-last 1) and ccomm's state signals keep only the newest value, so a receiver "
+                 "descheduled for two periods loses one.\n")
         L.append("| row | values/s without loss | delivered at the first lossy step | p50 µs there | CPU/value µs "
                  "| steps |")
         L.append("|---|---:|---:|---:|---:|---|")

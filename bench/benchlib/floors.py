@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from . import procs, results
 from .procs import Failed, Skip
 
-PROGRAMS = ("shm_floor", "net_floor", "lcm_pingpong", "iox_pingpong")
+PROGRAMS = ("shm_floor", "net_floor", "lcm_pingpong", "iox_pingpong", "dds_pingpong")
 
 
 @dataclass

@@ -6,7 +6,7 @@ the target judgements are in targets.py, section 4 (cost) in cost.py, the closin
 
 import os
 
-from . import cost, per_entry, reproduce
+from . import cost, peers, per_entry, reproduce
 from .formatting import Rows, fmt_ratio, md_table, median, num, paired_ratios, ratio, style, us, usr
 from .targets import TARGETS, checks, explain_misses
 
@@ -316,6 +316,8 @@ def render(rows, meta, problems, doc_dir, pngs, outdir=None):
         if fr:
             L.append("Frames per cycle (the sending ccommd's frames_tx minus heartbeats / cycles sent): " +
                      ", ".join("`%s` %s" % (r["name"], r["frames_per_cycle"]) for r in fr) + ".\n")
+
+    L += peers.section(R, meta, problems)
 
     if any(r.get("section") == "thesis" for r in rows):
         L.append("## 3. The thesis experiments\n")

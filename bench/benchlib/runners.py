@@ -7,10 +7,11 @@ leave their data in ctx.cost); RUNNERS maps a kind to its runner."""
 
 import dataclasses
 import os
+import resource
 import shutil
 import time
 
-from . import callgrind, ccomm, large, procs
+from . import callgrind, ccomm, large, peers, procs
 from .ccomm import Daemons, Failed, Skip
 
 # A spinning SCHED_FIFO thread is throttled after 0.95 s of every second
@@ -66,6 +67,7 @@ def run_pingpong(ctx, case):
         if o.get("interleave"):
             floor_shm = "/ccbench-floor-%d-%s" % (os.getpid(), case.name)
             exe += ["--floor-shm", floor_shm, "--block", "1000"]
+        cpu0 = _cpu_mark(d, [ccomm.LOCAL_NODE])
         echo = procs.start_background(exe + ["--role", "echo"] + ctx.side_opts("b"),
                                       os.path.join(ctx.workdir, case.name + ".echo.log"))
         try:
@@ -78,6 +80,12 @@ def run_pingpong(ctx, case):
             procs.forget(echo)
             if floor_shm and os.path.exists("/dev/shm" + floor_shm):
                 os.unlink("/dev/shm" + floor_shm)  # the ping removes it; not after a failure
+        cpu_ns = _cpu_since(d, [ccomm.LOCAL_NODE], cpu0)
+    # CPU per value (issue 30): both processes' whole lives and ccommd, per value handed over
+    # (two per round trip; interleaved floor blocks count too: they ran in the same processes).
+    trips = row["count"] + row["lost"] + 1000 + (row.get("floor_count") or 0)
+    if cpu_ns is not None:
+        row.update(cpu_ns, values=2 * trips, cpu_ns_per_value=round(cpu_ns["cpu_ns"] / (2.0 * trips)))
     row["raw"] = os.path.relpath(os.path.join(ctx.rawdir, case.name + ".tsv"), ctx.outdir)
     row.update(style=o["wait"], signal_kind=o["kind"], clock=o["clock"], command=argv)
     return [row]
@@ -166,6 +174,7 @@ def run_pair(ctx, case):
         sa = os.path.join(ctx.workdir, case.name + ".a.samples")
         sb = os.path.join(ctx.workdir, case.name + ".b.samples")
         before = _snapshot(d, names)
+        cpu0 = _cpu_mark(d, names)
         if o["mode"] == "ping":
             apps = [("b", _app(ctx, d, "b", names[1], rate, dur + 0.6, case.name + "-echo", sb, mode="echo"), 0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name, sa, mode="ping"), 0.3)]
@@ -176,18 +185,61 @@ def run_pair(ctx, case):
                      0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name + "-src", sa, warmup=warm), lead)]
         res = ccomm.run_apps(d, apps, dur + 30)
+        cpu_ns = _cpu_since(d, names, cpu0)
         after = _snapshot(d, names)
     dirn = ccomm.delta_stats(before, after, names[0], names[1])
     extra = dict(style=o["style"], signals=k, elements=count, signal_kind="state", wire=dirn, sent=res["a"]["sent"],
                  frames_per_cycle=_ratio(dirn["data_frames"], res["a"]["sent"]),
                  command=res["b"]["argv"] if o["mode"] == "oneway" else res["a"]["argv"],
                  daemon_command=d.argv[names[0]])
+    # CPU per value (issue 30, like the peers' rows): both applications' whole lives and both
+    # ccommds over the same time, per value delivered (a round trip delivers two).
+    values = (res["a"].get("sent") or 0) * (2 if o["mode"] == "ping" else 1)
+    if cpu_ns is not None and values:
+        extra.update(cpu_ns, values=values, cpu_ns_per_value=round(cpu_ns["cpu_ns"] / float(values)))
     if o["mode"] == "ping":
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["a"], sa, ctx.rawdir,
                                 metric="rtt_half", **extra)
     else:
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["b"], sb, ctx.rawdir,
                                 **extra)
+    return [row]
+
+
+def _cpu_mark(d, names):
+    """CPU time so far of the waited-for children (the applications, once they exit) and
+    of each ccommd's threads (schedstat ns)."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    daemons = {n: (d.cpu(n) or (0, 0))[1] for n in names}
+    return (ru.ru_utime + ru.ru_stime) * 1e9, daemons
+
+
+def _cpu_since(d, names, mark):
+    """{"cpu_ns", "cpu_apps_ns", "cpu_daemons_ns"} used since _cpu_mark() by the
+    applications run in between (utime+stime of every waited-for child) and by the
+    ccommds; None if a daemon could not be read."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    apps = int((ru.ru_utime + ru.ru_stime) * 1e9 - mark[0])
+    daemons = 0
+    for n in names:
+        c = d.cpu(n)
+        if c is None:
+            return None
+        daemons += c[1] - mark[1][n]
+    return {"cpu_ns": apps + daemons, "cpu_apps_ns": apps, "cpu_daemons_ns": daemons}
+
+
+def run_throughput(ctx, case):
+    """8 B one way (one state signal, sent as the application flushes) at the peers'
+    rising rates (peers.sweep) until the receiving application misses values."""
+    def measure(rate):
+        sub = dataclasses.replace(case, name="%s_%d" % (case.name, rate),
+                                  seconds=max(case.seconds, case.opts["min_values"] / float(rate)),
+                                  opts={"transport": case.opts["transport"], "signals": 1, "mode": "oneway",
+                                        "style": "block", "rate": rate})
+        return run_pair(ctx, sub)[0]
+    row = peers.sweep(measure, [r for r in peers.THROUGHPUT_RATES if r])
+    row["name"] = case.name
     return [row]
 
 
@@ -394,6 +446,6 @@ def run_callgrind_client(ctx, case):
     return []
 
 
-RUNNERS = {"large": large.run_large, "ccomm_local": run_local, "ccomm_pp": run_pingpong,
+RUNNERS = {"ccomm_tput": run_throughput, "large": large.run_large, "ccomm_local": run_local, "ccomm_pp": run_pingpong,
            "ccomm_pair": run_pair, "thesis": run_thesis, "idle": run_idle, "callgrind": run_callgrind,
            "callgrind_client": run_callgrind_client}

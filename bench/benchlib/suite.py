@@ -24,13 +24,14 @@ import re
 import time
 from dataclasses import dataclass, field
 
-from . import ccomm, floors, results, runners
+from . import ccomm, floors, peers, results, runners
 from .ccomm import Failed, Skip
 from .floors import Case
 from .runners import SPIN_SECONDS
 
 THESIS_RATES = (100, 200, 300, 400, 500, 600, 700, 800, 900, 1000, 10000)
 REPEAT = "~%d"  # name suffix of a repeated half; merge_repeats() joins them
+floors.RUNNERS.update(peers.RUNNERS)
 
 
 @dataclass
@@ -43,7 +44,7 @@ class CCase:
     opts: dict = field(default_factory=dict)
 
     def est_seconds(self):
-        return self.seconds + {"ccomm_local": 1.2, "ccomm_pp": 1.0, "ccomm_pair": 2.5, "thesis": 2.5,
+        return self.seconds * (6 if self.kind == "ccomm_tput" else 1) + {"ccomm_local": 1.2, "ccomm_pp": 1.0, "ccomm_pair": 2.5, "thesis": 2.5,
                                "idle": 1.5, "callgrind": 12.0, "callgrind_client": 5.0}.get(self.kind, 1.0)
 
 
@@ -147,6 +148,30 @@ def plan(smoke=False, rates=None, scale=1.0):
     cases.append(CCase("ccomm_raw_rtt_half_block_1khz_p288", "b2b", "ccomm_pair", d,
                        {"transport": "raw", "signals": 36, "mode": "ping", "style": "block", "rate": 1000}))
 
+    # ---- today's peers (issue 30), beside the ccomm rows above: board to board Cyclone DDS
+    # and Zenoh (one-way and RTT/2, 1 kHz and back to back, 8 / 288 B; throughput at 8 B
+    # until loss, each step at least min_values values so the loss limit means something),
+    # on one machine iceoryx2 (busy-poll and listener/notifier). peers.py.
+    for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("udp",))):
+        for q in qoss:
+            o = {"peer": peer, "reliable": q == "rel"}
+            for p in (8, 288):
+                cases.append(Case("%s_%s_oneway_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p, 1000,
+                                  dict(o, role="oneway")))
+                cases.append(Case("%s_%s_rtt_half_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p,
+                                  1000, dict(o, role="rtt", half=True)))
+                cases.append(Case("%s_%s_rtt_half_b2b_p%d" % (peer, q, p), "peer_net", "peers", n(5000, 300), p, 0,
+                                  dict(o, role="rtt", half=True)))
+            cases.append(Case("%s_%s_throughput_p8" % (peer, q), "peer_tput", "peers", 1000, 8, 0,
+                              dict(o, step_seconds=secs(0.5, 0.1), min_values=n(2000, 200))))
+    for t in ("raw", "udp"):
+        cases.append(CCase("ccomm_%s_throughput_p8" % t, "peers", "ccomm_tput", secs(0.5, 0.2),
+                           {"transport": t, "min_values": n(2000, 200)}))
+    for wait in ("spin", "event"):
+        for p in (8, 72, 288):
+            cases.append(Case("iox2_%s_b2b_p%d" % (wait, p), "iox2", "peers", n(50000 if wait == "spin" else 10000,
+                                                                             1000), p, 0, {"wait": wait}))
+
     # ---- the thesis experiments ----
     rates = rates or THESIS_RATES
     for exp in ("single", "setup"):
@@ -188,6 +213,7 @@ SMOKE_CASES = {
     "ccomm_raw_rtt_half_block_1khz_p8",
     "thesis_single_event_1khz", "thesis_setup_event_1khz", "thesis_setup_periodic_1khz",
     "thesis_setup_event_spin_10khz",
+    "dds_be_oneway_1khz_p8", "dds_rel_rtt_half_1khz_p8", "dds_be_throughput_p8", "ccomm_raw_throughput_p8",
     "cost_idle", "cost_callgrind_single", "cost_callgrind_client", "large_raw_oneway_100hz_p65536",
 }
 

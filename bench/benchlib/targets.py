@@ -3,6 +3,7 @@
 the report's target table per target: met, MISSED, reported or n/a, with the numbers)
 and explain_misses() (why a target was missed, from the run's own numbers)."""
 
+from . import peers
 from .formatting import median, paired_ratios, ratio, style, us
 
 
@@ -23,6 +24,7 @@ def checks(R, meta):
     """One dict per line of the target table: status, text, detail, and why (the kind of
     explanation explain_misses() gives when the target is missed)."""
     out = []
+    out += peers.checks(R, _check)
     # 1. board -> board raw p50 <= 1.3x floor (same payload, rate, receive style).
     for t in ("raw", "udp"):
         for p in (8, 288):
@@ -182,7 +184,7 @@ def explain_misses(R, meta, cks):
         for c in missed:
             if c["why"] in done:
                 continue
-            if c["why"] != "b2b":  # each board-to-board miss has its own numbers
+            if c["why"] not in ("b2b", "peers"):  # each board-to-board or peer miss has its own numbers
                 done.add(c["why"])
             L.append("**%s** — %s\n" % (c["text"], c["detail"]))
             w = _why(R, meta, c, said)
@@ -265,6 +267,8 @@ def _why(R, meta, check, said):
                 "CPU in that run: %s of a CPU (mostly system time in the veth send/receive path), on one CPU "
                 "per board that also runs the application." % (r["rate_hz"], r["packets_per_cycle"], r["name"],
                                                                 pct or "-"))
+    if check["why"] == "peers":
+        return peers.why(R, check)
     if check["why"] == "loss":
         rows = [r for r in R.where(section="thesis", mode="event") if r["rate_hz"] == 10000 and r.get("cpu")]
         extra = ""

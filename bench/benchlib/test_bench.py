@@ -125,3 +125,42 @@ class ReportTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class PeersTest(unittest.TestCase):
+    """The peer comparison (issue 30): the throughput sweep and the target lines."""
+
+    def test_sweep_stops_at_first_lossy_step(self):
+        from . import peers
+        seen = []
+
+        def measure(rate):
+            seen.append(rate)
+            lost = 0 if rate <= 2000 else 50
+            return {"rate_hz": rate, "count": 1000 - lost, "lost": lost, "p50_ns": 1000, "rx_values_per_s": rate}
+        row = peers.sweep(measure, peers.THROUGHPUT_RATES)
+        self.assertEqual(seen, [1000, 2000, 5000])
+        self.assertEqual(row["values_per_s_lossfree"], 2000)
+        self.assertEqual(row["values_per_s_at_loss"], 5000)
+        # Within the loss limit counts as without loss; beyond it does not.
+        self.assertFalse(peers.lossy({"count": 10000, "lost": 10}))
+        self.assertTrue(peers.lossy({"count": 10000, "lost": 11}))
+        self.assertTrue(peers.lossy({"count": 0, "lost": 0}))
+
+    def test_peer_targets_judge_and_name_missing_rows(self):
+        from . import formatting, peers, targets
+
+        def row(name, p50, cpu):
+            return {"name": name, "p50_ns": p50, "cpu_ns_per_value": cpu}
+        R = formatting.Rows([row("ccomm_udp_oneway_block_1khz_p8", 50000, 90000),
+                             row("dds_be_oneway_1khz_p8", 60000, 80000)])
+        cks = peers.checks(R, targets._check)
+        by = {(c["rows"][1], c["rows"][2]): c for c in cks if "rows" in c}
+        self.assertEqual(by[("dds_be_oneway_1khz_p8", "p50_ns")]["status"], "met")
+        miss = by[("dds_be_oneway_1khz_p8", "cpu_ns_per_value")]
+        self.assertEqual(miss["status"], "MISSED")
+        self.assertIn("over by 10.00 µs", miss["detail"])
+        # Every peer row without its data is a line of its own saying what is missing.
+        absent = [c for c in cks if "zenoh_udp_oneway_1khz_p8" in c["text"]]
+        self.assertEqual(len(absent), 2)
+        self.assertTrue(all(c["status"] == "n/a" and "`zenoh_udp_oneway_1khz_p8`" in c["detail"] for c in absent))

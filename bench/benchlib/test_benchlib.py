@@ -302,3 +302,69 @@ class DriverTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class DdsPeerTest(unittest.TestCase):
+    """dds_pingpong (Cyclone DDS) on loopback: its statistics agree with its raw dump,
+    a round trip is two values, and bad usage is refused."""
+
+    def _run_pair(self, roles, args, tag):
+        from . import peers
+        exe = prog("dds_pingpong")
+        env = dict(os.environ, CYCLONEDDS_URI=peers.dds_config("127.0.0.1", "lo", tag))
+        partner = subprocess.Popen([exe, "--role", roles[0], "--idle-ms", "20000"] + args, env=env,
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            main = subprocess.run([exe, "--role", roles[1]] + args, env=env, stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True, timeout=90)
+            pout, perr = partner.communicate(timeout=30)
+        finally:
+            if partner.poll() is None:
+                partner.kill()
+                partner.wait()
+        return main, pout, perr
+
+    def test_ping_echo_rtt(self):
+        with tempfile.TemporaryDirectory() as d:
+            dump = os.path.join(d, "d.tsv")
+            main, _, perr = self._run_pair(("echo", "ping"), ["--rate", "0", "--count", "300", "--warmup", "20",
+                                                               "--dump", dump, "--reliable"],
+                                           "t%d" % os.getpid())
+            self.assertEqual(main.returncode, 0, main.stderr)
+            row = results.parse_program_output(main.stdout)
+            self.assertEqual(row["transport"], "dds_reliable")
+            self.assertEqual(row["count"] + row["lost"], 300)
+            self.assertEqual(row["values"], 2 * (row["count"] + 20))
+            self.assertGreater(row["cpu_ns"], 0)
+            self.assertIn('"cpu_ns"', perr)  # the echo's CPU time, for CPU per value
+            ProgramTest.check_against_dump(self, row, dump)
+
+    def test_source_sink_one_way(self):
+        with tempfile.TemporaryDirectory() as d:
+            dump = os.path.join(d, "s.tsv")
+            args = ["--rate", "2000", "--count", "400", "--warmup", "20", "--payload", "288"]
+            exe = prog("dds_pingpong")
+            from . import peers
+            env = dict(os.environ, CYCLONEDDS_URI=peers.dds_config("127.0.0.1", "lo", "s%d" % os.getpid()))
+            sink = subprocess.Popen([exe, "--role", "sink", "--idle-ms", "20000", "--dump", dump] + args, env=env,
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            try:
+                src = subprocess.run([exe, "--role", "source"] + args, env=env, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True, timeout=90)
+                out, _ = sink.communicate(timeout=30)
+            finally:
+                if sink.poll() is None:
+                    sink.kill()
+                    sink.wait()
+            self.assertEqual(src.returncode, 0, src.stderr)
+            row = results.parse_program_output(out)
+            self.assertEqual(row["metric"], "one_way")
+            self.assertEqual(row["payload_bytes"], 288)
+            self.assertEqual(row["count"] + row["lost"], 400)
+            self.assertGreater(row["count"], 0)
+            ProgramTest.check_against_dump(self, row, dump)
+
+    def test_bad_usage(self):
+        exe = prog("dds_pingpong")
+        for args in ([], ["--role", "x"], ["--role", "ping", "--idle-ms", "0"], ["--role", "sink", "extra"]):
+            self.assertEqual(subprocess.run([exe] + args, stderr=subprocess.DEVNULL).returncode, 2, args)

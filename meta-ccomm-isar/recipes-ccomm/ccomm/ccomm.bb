@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: Apache-2.0
+# ccommd, libccomm0 and libccomm-dev as Debian packages, built by sbuild from this
+# repository's working tree with its own Debian packaging (packaging/debian), cross-compiled
+# (ISAR_CROSS_COMPILE, Isar's default). One more package, ccomm-bench, for test images: the
+# latency floor programs (bench/) the QEMU suite compares ccomm with. python3-ccomm is architecture-independent and not
+# built in a cross build; scripts/package builds it.
+DESCRIPTION = "ccomm: real-time signal exchange between robot-control boards"
+MAINTAINER = "the ccomm developers <ccomm-dev@lists.example.org>"
+LICENSE = "Apache-2.0"
+LIC_FILES_CHKSUM = "file://${CCOMM_TOPDIR}/LICENSE;md5=3b83ef96387f14655fc854ddc3c6bd57"
+
+inherit dpkg
+
+# The binary packages it builds, for IMAGE_INSTALL.
+PROVIDES += "ccommd libccomm0 libccomm-dev ccomm-bench"
+
+PV = "${@ccomm_version(d)}"
+S = "${WORKDIR}/ccomm"
+
+# The version packaging/debian/changelog states: sbuild names the packages after it.
+def ccomm_version(d):
+    import re
+    with open(d.getVar('CCOMM_TOPDIR') + '/packaging/debian/changelog') as f:
+        return re.match(r'\S+ \(([^)]+)\)', f.readline()).group(1)
+
+# The tree is not fetched: it is the checkout this layer is in. What identifies its content
+# (commit plus uncommitted changes) comes from scripts/build-image as CCOMM_SOURCE_ID, so
+# a changed tree rebuilds the packages and an unchanged one reuses them.
+CCOMM_SOURCE_ID ??= "unknown"
+do_prepare_build[vardeps] += "CCOMM_SOURCE_ID"
+do_prepare_build[dirs] = "${WORKDIR}"
+do_prepare_build() {
+    rm -rf ${S}
+    mkdir -p ${S}
+    # Only what the package build reads: no build trees, no layers, no test runs.
+    (cd ${CCOMM_TOPDIR} && tar -cf - --exclude='./build*' --exclude=./.git \
+        --exclude=./meta-ccomm-isar --exclude=./meta-ccomm --exclude=./qemu-tests \
+        --exclude=./recipes-ccomm --exclude=./recipes-kernel .) | tar -xf - -C ${S}
+    rm -rf ${S}/debian
+    cp -r ${S}/packaging/debian ${S}/debian
+    # Cross build: the tools that run during the build come from the build machine's
+    # architecture (apt's :native), everything linked into ccomm from armhf.
+    sed -i -e 's/^\( *\)\(python3\|python3-setuptools\|python3-wheel\|pandoc\),/\1\2:native,/' \
+        -e 's/^\( *\)pandoc$/\1pandoc:native/' ${S}/debian/control
+    # ccomm-bench: the floor programs, without the peers (LCM, iceoryx).
+    sed -i 's/-DCCOMM_BUILD_BENCH=OFF/-DCCOMM_BUILD_BENCH=ON -DCCOMM_BENCH_PEERS=OFF/' ${S}/debian/rules
+    grep -q 'CCOMM_BUILD_BENCH=ON' ${S}/debian/rules
+    cat >>${S}/debian/control <<'EOT'
+
+Package: ccomm-bench
+Architecture: any
+Depends: ${shlibs:Depends}, ${misc:Depends}, libccomm0 (= ${binary:Version})
+Description: real-time signal exchange between robot-control boards (latency floors)
+ The programs ccomm's latency is compared with (raw sockets, shared memory hand-off),
+ for test images.
+EOT
+    echo usr/libexec/ccomm/bench >${S}/debian/ccomm-bench.install
+}

@@ -2,8 +2,9 @@
 # U-Boot SPL (MLO) and U-Boot (u-boot.img) for the Gumstix Overo, cross-built from Debian
 # bookworm's u-boot source package with U-Boot's omap3_overo_defconfig: Debian's
 # u-boot-omap carries other OMAP boards (BeagleBoard, IGEP, Panda, ...), not the Overo.
-# Package u-boot-ramstix: /usr/lib/u-boot/ramstix/{MLO,u-boot.img}, for the SD card's FAT
-# partition (IMAGE_BOOT_FILES of conf/machine/ramstix.conf).
+# Package u-boot-ramstix: /usr/lib/u-boot/ramstix/{MLO,u-boot.img,boot.scr}, for the SD
+# card's FAT partition (IMAGE_BOOT_FILES of conf/machine/ramstix.conf); boot.scr is
+# files/boot.cmd made a U-Boot script by the mkimage this build makes.
 DESCRIPTION = "U-Boot for the RaMstix (Gumstix Overo)"
 MAINTAINER = "the ccomm developers <ccomm-dev@lists.example.org>"
 LICENSE = "GPL-2.0-or-later"
@@ -11,7 +12,7 @@ LIC_FILES_CHKSUM = "file://${LAYERDIR_core}/licenses/COPYING.GPLv2;md5=751419260
 
 inherit dpkg
 
-SRC_URI = "apt://u-boot"
+SRC_URI = "apt://u-boot file://boot.cmd"
 PV = "2023.01"
 S = "${WORKDIR}/u-boot-src"
 U_BOOT_CONFIG = "omap3_overo_defconfig"
@@ -46,15 +47,18 @@ endif
 override_dh_auto_configure:
 	$(MAKE) ${U_BOOT_CONFIG}
 override_dh_auto_build:
-	$(MAKE) $(PARALLEL_MAKE) MLO u-boot.img
+	$(MAKE) $(PARALLEL_MAKE) MLO u-boot.img tools
+	tools/mkimage -A arm -O linux -T script -C none -n "RaMstix boot" -d debian/boot.cmd boot.scr
 override_dh_auto_test:
 override_dh_auto_install:
 	install -D -m 644 MLO debian/u-boot-ramstix/usr/lib/u-boot/ramstix/MLO
 	install -D -m 644 u-boot.img debian/u-boot-ramstix/usr/lib/u-boot/ramstix/u-boot.img
+	install -D -m 644 boot.scr debian/u-boot-ramstix/usr/lib/u-boot/ramstix/boot.scr
 override_dh_strip:
 override_dh_dwz:
 EOT
     chmod +x ${S}/debian/rules
+    cp ${WORKDIR}/boot.cmd ${S}/debian/boot.cmd
     mkdir -p ${S}/debian/source
     echo "1.0" >${S}/debian/source/format
     deb_add_changelog

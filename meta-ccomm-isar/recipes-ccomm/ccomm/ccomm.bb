@@ -38,10 +38,13 @@ do_prepare_build() {
         --exclude=./recipes-ccomm --exclude=./recipes-kernel .) | tar -xf - -C ${S}
     rm -rf ${S}/debian
     cp -r ${S}/packaging/debian ${S}/debian
-    # Cross build: the tools that run during the build come from the build machine's
-    # architecture (apt's :native), everything linked into ccomm from armhf.
-    sed -i -e 's/^\( *\)\(python3\|python3-setuptools\|python3-wheel\|pandoc\),/\1\2:native,/' \
-        -e 's/^\( *\)pandoc$/\1pandoc:native/' ${S}/debian/control
+    # Cross build: python3 runs during the build, so it is the build machine's (apt and
+    # dpkg's :native), and so is python3-wheel (architecture-independent without a
+    # Multi-Arch field: apt would look for an armhf one). pandoc and python3-setuptools are
+    # Multi-Arch foreign and resolve to the build machine's unqualified (dpkg refuses
+    # :native on them). Everything ccomm links against is armhf.
+    sed -i -e 's/^\( *\)\(python3\|python3-wheel\),/\1\2:native,/' ${S}/debian/control
+    grep -q 'python3-wheel:native' ${S}/debian/control
     # ccomm-bench: the floor programs, without the peers (LCM, iceoryx).
     sed -i 's/-DCCOMM_BUILD_BENCH=OFF/-DCCOMM_BUILD_BENCH=ON -DCCOMM_BENCH_PEERS=OFF/' ${S}/debian/rules
     grep -q 'CCOMM_BUILD_BENCH=ON' ${S}/debian/rules

@@ -27,7 +27,9 @@ USER_root[password] = "ccomm"
 USER_root[flags] = "clear-text-password"
 
 # RaMstix: the Overo's U-Boot loads /boot/zImage and /boot/<fdtfile> from the root
-# partition (docs/yocto.md): copies of Debian's kernel and device trees under those names.
+# partition (docs/yocto.md): copies of Debian's kernel and device trees under those names
+# (a kernel upgrade on the board needs them copied again). The initramfs, generated after
+# this step, boot.scr loads through Debian's /initrd.img link.
 ROOTFS_POSTPROCESS_COMMAND:append:ramstix = " ccomm_ramstix_boot_files"
 ccomm_ramstix_boot_files() {
     sudo -s <<EOSUDO

@@ -23,19 +23,21 @@ def ccomm_version(d):
     with open(d.getVar('CCOMM_TOPDIR') + '/packaging/debian/changelog') as f:
         return re.match(r'\S+ \(([^)]+)\)', f.readline()).group(1)
 
-# The tree is not fetched: it is the checkout this layer is in. What identifies its content
-# (commit plus uncommitted changes) comes from scripts/build-image as CCOMM_SOURCE_ID, so
-# a changed tree rebuilds the packages and an unchanged one reuses them.
+# The tree is not fetched: it is the checkout this layer is in, less what the package build
+# does not read (the layers, the test suites; CMake builds tests only with
+# CCOMM_BUILD_TESTS, which packaging/debian turns off). What identifies its content comes
+# from scripts/build-image as CCOMM_SOURCE_ID (a hash of the same files, with this list),
+# so a changed tree rebuilds the packages and an unchanged one reuses them.
+CCOMM_PACKAGE_EXCLUDES = "meta-ccomm-isar meta-ccomm recipes-ccomm recipes-kernel qemu-tests tests"
 CCOMM_SOURCE_ID ??= "unknown"
-do_prepare_build[vardeps] += "CCOMM_SOURCE_ID"
+do_prepare_build[vardeps] += "CCOMM_SOURCE_ID CCOMM_PACKAGE_EXCLUDES"
 do_prepare_build[dirs] = "${WORKDIR}"
 do_prepare_build() {
     rm -rf ${S}
     mkdir -p ${S}
-    # Only what the package build reads: no build trees, no layers, no test runs.
-    (cd ${CCOMM_TOPDIR} && tar -cf - --exclude='./build*' --exclude=./.git \
-        --exclude=./meta-ccomm-isar --exclude=./meta-ccomm --exclude=./qemu-tests \
-        --exclude=./recipes-ccomm --exclude=./recipes-kernel .) | tar -xf - -C ${S}
+    excludes=""
+    for e in ${CCOMM_PACKAGE_EXCLUDES}; do excludes="$excludes --exclude=./$e"; done
+    (cd ${CCOMM_TOPDIR} && tar -cf - --exclude=./.git $excludes .) | tar -xf - -C ${S}
     rm -rf ${S}/debian
     cp -r ${S}/packaging/debian ${S}/debian
     # Cross build: python3 runs during the build, so it is the build machine's (apt and

@@ -44,3 +44,19 @@ ccomm_ramstix_boot_files() {
         done
 EOSUDO
 }
+
+# The initramfs only needs to find the root file system: the drivers for it, listed, not
+# Debian's default MODULES=most (some 1000 modules, each copied through qemu-user in the
+# build: minutes, and a larger initramfs on every boot).
+CCOMM_INITRAMFS_MODULES = "ext4"
+CCOMM_INITRAMFS_MODULES:append:qemuarm = " virtio_mmio virtio_blk"
+CCOMM_INITRAMFS_MODULES:append:ramstix = " omap_hsmmc mmc_block"
+ROOTFS_POSTPROCESS_COMMAND += "ccomm_initramfs_modules"
+ccomm_initramfs_modules() {
+    sudo -s <<EOSUDO
+        set -e
+        mkdir -p '${ROOTFSDIR}/etc/initramfs-tools/conf.d'
+        echo MODULES=list >'${ROOTFSDIR}/etc/initramfs-tools/conf.d/ccomm-modules.conf'
+        printf '%s\n' ${CCOMM_INITRAMFS_MODULES} >>'${ROOTFSDIR}/etc/initramfs-tools/modules'
+EOSUDO
+}

@@ -28,7 +28,7 @@ Source: u-boot-ramstix
 Section: admin
 Priority: optional
 Maintainer: ${MAINTAINER}
-Build-Depends: debhelper-compat (= 13), bc, bison:native, flex:native, device-tree-compiler:native,
+Build-Depends: debhelper-compat (= 13), bc, bison, flex, device-tree-compiler,
  libssl-dev:native, libgnutls28-dev:native, uuid-dev:native, python3:native
 Standards-Version: 4.6.2
 Rules-Requires-Root: no

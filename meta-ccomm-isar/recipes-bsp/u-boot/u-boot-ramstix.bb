@@ -1,7 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-# U-Boot SPL (MLO) and U-Boot (u-boot.img) for the Gumstix Overo, cross-built from Debian
-# bookworm's u-boot source package with U-Boot's omap3_overo_defconfig: Debian's
-# u-boot-omap carries other OMAP boards (BeagleBoard, IGEP, Panda, ...), not the Overo.
+# U-Boot SPL (MLO) and U-Boot (u-boot.img) for the Gumstix Overo, cross-built from Debian's
+# u-boot source package with U-Boot's omap3_overo_defconfig: Debian's u-boot-omap carries
+# other OMAP boards (BeagleBoard, IGEP, Panda, ...), not the Overo.
+# KNOWN BROKEN: bookworm's u-boot source (2023.01) no longer has the Overo board (no
+# configs/omap3_overo_defconfig): do_dpkg_build stops at the configure step. It needs a
+# U-Boot that still has it (bullseye's 2021.01 source, or Gumstix's fork) (docs/yocto.md).
 # Package u-boot-ramstix: /usr/lib/u-boot/ramstix/{MLO,u-boot.img,boot.scr}, for the SD
 # card's FAT partition (IMAGE_BOOT_FILES of conf/machine/ramstix.conf); boot.scr is
 # files/boot.cmd made a U-Boot script by the mkimage this build makes.

@@ -7,9 +7,10 @@
 #
 # libc and libstdc++ come from the cross toolchain itself (/usr/arm-linux-gnueabihf).
 # The few armhf libraries ccomm links against (libsystemd, libsodium; RapidXML is header
-# only) are not installed on the build host: scripts/build-armhf-image extracts their
-# Debian armhf packages into a directory and passes it as CCOMM_ARMHF_DEPS (or the
-# environment variable of the same name). That keeps the host's dpkg untouched (no
+# only) are not installed on the build host: extract their Debian armhf packages
+# (dpkg-deb -x) into a directory and pass it as CCOMM_ARMHF_DEPS (or the environment
+# variable of the same name). The board images do not use this file: the Isar layer
+# cross-builds ccomm's Debian packages with sbuild (scripts/build-image). That keeps the host's dpkg untouched (no
 # `dpkg --add-architecture`, no multi-arch version lock-step with host packages) and the
 # extracted tree can be cached, keyed on the package versions.
 

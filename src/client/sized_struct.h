@@ -11,16 +11,25 @@
 namespace ccomm::client {
 
 // The size each struct had when its *_sized call appeared (ccomm 0.2.0): the smallest a
-// caller may pass. Fixed forever; the structs only grow beyond it.
+// caller may pass. Fixed forever: the end of the member that was last then, rounded to the
+// struct's alignment, so it is right on every ABI (a 32-bit board's pointers are 4 bytes)
+// and stays put when members are appended.
+constexpr size_t EndOfFirstLayout(size_t member_end, size_t align) { return (member_end + align - 1) / align * align; }
+#define CCOMM_FIRST_LAYOUT_ENDS_AT(T, last)                                                          \
+  template <>                                                                                        \
+  struct FirstSize<T> {                                                                              \
+    static constexpr size_t value = EndOfFirstLayout(offsetof(T, last) + sizeof(T::last), alignof(T)); \
+  }
 template <typename T> struct FirstSize;
-template <> struct FirstSize<ccomm_signal_desc> { static constexpr size_t value = 48; };
-template <> struct FirstSize<ccomm_signal_stats> { static constexpr size_t value = 104; };
-template <> struct FirstSize<ccomm_peer_stats> { static constexpr size_t value = 72; };
-template <> struct FirstSize<ccomm_view_node> { static constexpr size_t value = 112; };
-template <> struct FirstSize<ccomm_view_signal> { static constexpr size_t value = 40; };
-template <> struct FirstSize<ccomm_view_counters> { static constexpr size_t value = 48; };
-template <> struct FirstSize<ccomm_peer_clock> { static constexpr size_t value = 40; };
-template <> struct FirstSize<ccomm_clock_state> { static constexpr size_t value = 24; };
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_signal_desc, consumed_here);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_signal_stats, values_incomplete);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_peer_stats, last_rx_age_ns);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_view_node, summaries);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_view_signal, age_ns);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_view_counters, summary_ms);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_peer_clock, frames_delayed);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_clock_state, path_delay_ns);
+#undef CCOMM_FIRST_LAYOUT_ENDS_AT
 
 // Copies `full` into the caller's `size` bytes at `out`: the first min(size, sizeof)
 // bytes, zeros beyond (a caller built against a newer header). CCOMM_E_INVAL for a

@@ -111,7 +111,6 @@ bool Monitor::OpenSocket() {
   self.sun_family = AF_UNIX;
   const int n = snprintf(self.sun_path + 1, sizeof self.sun_path - 1, "ccommd-ptp.%d.%p", getpid(),
                          static_cast<void*>(this));
-  own_path_.assign(self.sun_path + 1, static_cast<size_t>(n));
   const socklen_t slen = static_cast<socklen_t>(offsetof(struct sockaddr_un, sun_path) + 1 + n);
   if (bind(fd_, reinterpret_cast<const sockaddr*>(&self), slen) != 0) {
     close(fd_);

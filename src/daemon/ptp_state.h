@@ -97,7 +97,6 @@ class Monitor {
   int64_t synced_within_ns_ = 1000000;
   uint8_t domain_ = 0;
   int fd_ = -1;
-  std::string own_path_;        // the socket's bound name: ptp4l answers to it
   uint16_t sequence_ = 0;
   uint64_t next_poll_ns_ = 0;
   uint64_t last_answer_ns_ = 0;  // 0: never

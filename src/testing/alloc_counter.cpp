@@ -4,6 +4,9 @@
 // ccomm_steady_state_end() when asked to stop; every malloc/calloc/realloc/
 // posix_memalign/aligned_alloc in between, from any thread, is counted. At exit the
 // count goes to $CCOMM_ALLOC_REPORT ("steady_state_allocations N", then "total_allocations M" incl. start-up).
+// CCOMM_ALLOC_BACKTRACE=1: each steady-state allocation also prints its call stack to stderr
+// (to find which code allocated; addr2line -e ccommd turns the addresses into lines).
+#include <execinfo.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,9 +24,20 @@ void __libc_free(void*);
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<unsigned long> g_count{0}, g_total{0};
+thread_local bool t_in_backtrace = false;
 inline void Count() {
   g_total.fetch_add(1, std::memory_order_relaxed);  // proves the interposer is live
-  if (g_counting.load(std::memory_order_relaxed)) g_count.fetch_add(1, std::memory_order_relaxed);
+  if (!g_counting.load(std::memory_order_relaxed)) return;
+  g_count.fetch_add(1, std::memory_order_relaxed);
+  static const bool trace = getenv("CCOMM_ALLOC_BACKTRACE") != nullptr;
+  if (trace && !t_in_backtrace) {
+    t_in_backtrace = true;  // backtrace() may allocate once (loading libgcc)
+    void* frames[32];
+    const int n = backtrace(frames, 32);
+    fputs("steady-state allocation:\n", stderr);
+    backtrace_symbols_fd(frames, n, 2);
+    t_in_backtrace = false;
+  }
 }
 }  // namespace
 

@@ -259,7 +259,7 @@ typedef struct {
 /* Long option codes for the shared options; programs start their own at 0x200. */
 enum {
     BO_NAME = 0x100, BO_DUMP, BO_CPU, BO_PRIO, BO_PAYLOAD, BO_RATE, BO_COUNT, BO_WARMUP,
-    BO_TIMEOUT, BO_HALF, BO_NO_MLOCK
+    BO_TIMEOUT, BO_HALF, BO_NO_MLOCK, BO_HELP
 };
 
 #define BENCH_COMMON_LONGOPTS                                                           \
@@ -268,7 +268,7 @@ enum {
     {"payload", required_argument, 0, BO_PAYLOAD}, {"rate", required_argument, 0, BO_RATE}, \
     {"count", required_argument, 0, BO_COUNT}, {"warmup", required_argument, 0, BO_WARMUP}, \
     {"timeout-ms", required_argument, 0, BO_TIMEOUT}, {"half", no_argument, 0, BO_HALF},   \
-    {"no-mlock", no_argument, 0, BO_NO_MLOCK}
+    {"no-mlock", no_argument, 0, BO_NO_MLOCK}, {"help", no_argument, 0, BO_HELP}
 
 #define BENCH_COMMON_HELP                                                                  \
     "  --name NAME        result name in the JSON line\n"                                  \
@@ -369,6 +369,69 @@ static inline int bench_common_opt(bench_opts *o, int opt, const char *arg)
     case BO_NO_MLOCK: o->no_mlock = 1; return 1;
     default: return 0;
     }
+}
+
+/* A bad option value ends the program the same way in every program: the option as
+ * written, the value, exit BENCH_EXIT_USAGE. Only right after getopt_long returned the
+ * option: `--opt value` leaves the option at argv[optind - 2], `--opt=value` at optind - 1. */
+__attribute__((noreturn)) static inline void bench_bad_value(char **argv, const char *arg)
+{
+    const char *written = arg && optind >= 2 && argv[optind - 1] == arg ? argv[optind - 2] : argv[optind - 1];
+    fprintf(stderr, "bad value for option %s: %s\n", written, arg ? arg : "");
+    exit(BENCH_EXIT_USAGE);
+}
+
+/*
+ * The command-line protocol of every floor and peer program, getopt_long style: returns
+ * the next option that is the program's own (-1 at the end). The shared options go into
+ * *o; --help prints usage to stdout and exits 0; an unknown option or a positional
+ * argument prints usage to stderr and a bad shared value says which, both exiting
+ * BENCH_EXIT_USAGE. `longopts` starts with BENCH_COMMON_LONGOPTS.
+ */
+static inline int bench_next_opt(int argc, char **argv, const struct option *longopts, bench_opts *o,
+                                 void (*usage)(FILE *))
+{
+    int opt;
+    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
+        int r = bench_common_opt(o, opt, optarg);
+        if (r < 0)
+            bench_bad_value(argv, optarg);
+        if (r == 1)
+            continue;
+        if (opt == BO_HELP) {
+            usage(stdout);
+            exit(BENCH_EXIT_OK);
+        }
+        if (opt < 0x200) { /* '?': unknown option or missing value */
+            usage(stderr);
+            exit(BENCH_EXIT_USAGE);
+        }
+        return opt;
+    }
+    if (optind != argc) {
+        usage(stderr);
+        exit(BENCH_EXIT_USAGE);
+    }
+    return -1;
+}
+
+/* The value of a mode option (e.g. --role echo|ping) as an index into the NULL-terminated
+ * `words`, in the order of the program's enum; ends the program on another word. */
+static inline int bench_choice_opt(char **argv, const char *arg, const char *const *words)
+{
+    int k = bench_choice(arg, words);
+    if (k < 0)
+        bench_bad_value(argv, arg);
+    return k;
+}
+
+/* The value of a milliseconds option in nanoseconds; 0 only where `zero_ok`. */
+static inline int64_t bench_ms_opt(char **argv, const char *arg, int zero_ok)
+{
+    uint64_t ms;
+    if (bench_parse_u64(arg, &ms) || (ms == 0 && !zero_ok) || ms > (uint64_t)INT64_MAX / 1000000u)
+        bench_bad_value(argv, arg);
+    return (int64_t)ms * 1000000LL;
 }
 
 /* ---- real-time set-up ---- */

@@ -285,8 +285,7 @@ int main(int argc, char **argv)
     enum waitmode wait = W_SPIN;
     int cycle_time = 0;
     uint64_t block = 1000;
-    enum { OPT_ROLE = 0x200, OPT_WAIT, OPT_NODE, OPT_PING, OPT_PONG, OPT_START, OPT_CYCLE, OPT_FLOOR, OPT_BLOCK,
-           OPT_HELP };
+    enum { OPT_ROLE = 0x200, OPT_WAIT, OPT_NODE, OPT_PING, OPT_PONG, OPT_START, OPT_CYCLE, OPT_FLOOR, OPT_BLOCK };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"role", required_argument, 0, OPT_ROLE},
                                              {"wait", required_argument, 0, OPT_WAIT},
@@ -297,54 +296,30 @@ int main(int argc, char **argv)
                                              {"cycle-time", no_argument, 0, OPT_CYCLE},
                                              {"floor-shm", required_argument, 0, OPT_FLOOR},
                                              {"block", required_argument, 0, OPT_BLOCK},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const roles[] = {"echo", "ping", NULL};  /* enum role */
+    static const char *const waits[] = {"spin", "block", NULL}; /* enum waitmode */
     int opt;
-    uint64_t u;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int r = bench_common_opt(&o, opt, optarg);
-        if (r == 1)
-            continue;
-        int bad = r < 0;
+    while ((opt = bench_next_opt(argc, argv, longopts, &o, usage)) != -1) {
         switch (opt) {
-        case OPT_ROLE: {
-            static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
-            int k = bench_choice(optarg, roles);
+        case OPT_ROLE:
+            role = (enum role)bench_choice_opt(argv, optarg, roles);
             have_role = 1;
-            role = (enum role)k;
-            bad = k < 0;
             break;
-        }
-        case OPT_WAIT: {
-            static const char *const waits[] = {"spin", "block", NULL}; /* enum waitmode */
-            int k = bench_choice(optarg, waits);
-            wait = (enum waitmode)k;
-            bad = k < 0;
-            break;
-        }
+        case OPT_WAIT: wait = (enum waitmode)bench_choice_opt(argv, optarg, waits); break;
         case OPT_NODE: node = optarg; break;
         case OPT_PING: ping_name = optarg; break;
         case OPT_PONG: pong_name = optarg; break;
-        case OPT_START:
-            bad = bench_parse_u64(optarg, &u) != 0;
-            start_wait = (int64_t)u * 1000000LL;
-            break;
+        case OPT_START: start_wait = bench_ms_opt(argv, optarg, 1); break;
         case OPT_CYCLE: cycle_time = 1; break;
         case OPT_FLOOR: floor_name = optarg; break;
-        case OPT_BLOCK: bad = bench_parse_u64(optarg, &block) != 0 || block == 0; break;
-        case OPT_HELP: usage(stdout); return 0;
-        default:
-            if (!bad) {
-                usage(stderr);
-                return BENCH_EXIT_USAGE;
-            }
-        }
-        if (bad) {
-            fprintf(stderr, "bad value for option: %s\n", optarg ? optarg : "");
-            return BENCH_EXIT_USAGE;
+        case OPT_BLOCK:
+            if (bench_parse_u64(optarg, &block) || block == 0)
+                bench_bad_value(argv, optarg);
+            break;
         }
     }
-    if (!have_role || !ping_name || !pong_name || optind != argc) {
+    if (!have_role || !ping_name || !pong_name) {
         usage(stderr);
         return BENCH_EXIT_USAGE;
     }

@@ -355,50 +355,27 @@ int main(int argc, char **argv)
     int have_role = 0, reliable = 0;
     enum role role = R_ECHO;
     int64_t idle = 20000000000LL, start_wait = 15000000000LL;
-    enum { OPT_ROLE = 0x200, OPT_RELIABLE, OPT_IDLE, OPT_START, OPT_HELP };
+    enum { OPT_ROLE = 0x200, OPT_RELIABLE, OPT_IDLE, OPT_START };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"role", required_argument, 0, OPT_ROLE},
                                              {"reliable", no_argument, 0, OPT_RELIABLE},
                                              {"idle-ms", required_argument, 0, OPT_IDLE},
                                              {"start-wait-ms", required_argument, 0, OPT_START},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const roles[] = {"echo", "ping", "source", "sink", NULL}; /* enum role */
     int opt;
-    uint64_t u;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int r = bench_common_opt(&o, opt, optarg);
-        if (r == 1)
-            continue;
-        if (r < 0) {
-            fprintf(stderr, "bad value for option: %s\n", optarg);
-            return BENCH_EXIT_USAGE;
-        }
+    while ((opt = bench_next_opt(argc, argv, longopts, &o, usage)) != -1) {
         switch (opt) {
-        case OPT_ROLE: {
-            static const char *const roles[] = {"echo", "ping", "source", "sink", NULL}; /* enum role */
-            int k = bench_choice(optarg, roles);
-            if (k < 0) {
-                fprintf(stderr, "unknown role %s\n", optarg);
-                return BENCH_EXIT_USAGE;
-            }
+        case OPT_ROLE:
+            role = (enum role)bench_choice_opt(argv, optarg, roles);
             have_role = 1;
-            role = (enum role)k;
             break;
-        }
         case OPT_RELIABLE: reliable = 1; break;
-        case OPT_IDLE:
-        case OPT_START:
-            if (bench_parse_u64(optarg, &u) || u == 0) {
-                fprintf(stderr, "bad %s\n", opt == OPT_IDLE ? "--idle-ms" : "--start-wait-ms");
-                return BENCH_EXIT_USAGE;
-            }
-            *(opt == OPT_IDLE ? &idle : &start_wait) = (int64_t)u * 1000000LL;
-            break;
-        case OPT_HELP: usage(stdout); return 0;
-        default: usage(stderr); return BENCH_EXIT_USAGE;
+        case OPT_IDLE: idle = bench_ms_opt(argv, optarg, 0); break;
+        case OPT_START: start_wait = bench_ms_opt(argv, optarg, 0); break;
         }
     }
-    if (!have_role || optind != argc) {
+    if (!have_role) {
         usage(stderr);
         return BENCH_EXIT_USAGE;
     }

@@ -93,55 +93,28 @@ int main(int argc, char **argv)
     int have_role = 0, persist = 0;
     int64_t start_wait = 10000000000LL;
     n.wait = W_SPIN;
-    enum { OPT_ROLE = 0x200, OPT_WAIT, OPT_PERSIST, OPT_START, OPT_HELP };
+    enum { OPT_ROLE = 0x200, OPT_WAIT, OPT_PERSIST, OPT_START };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"role", required_argument, 0, OPT_ROLE},
                                              {"wait", required_argument, 0, OPT_WAIT},
                                              {"persist", no_argument, 0, OPT_PERSIST},
                                              {"start-wait-ms", required_argument, 0, OPT_START},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const roles[] = {"echo", "ping", NULL};    /* enum role */
+    static const char *const waits[] = {"spin", "waitset", NULL}; /* enum waitmode */
     int opt;
-    uint64_t u;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int r = bench_common_opt(&o, opt, optarg);
-        if (r == 1)
-            continue;
-        int bad = r < 0;
+    while ((opt = bench_next_opt(argc, argv, longopts, &o, usage)) != -1) {
         switch (opt) {
-        case OPT_ROLE: {
-            static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
-            int k = bench_choice(optarg, roles);
+        case OPT_ROLE:
+            role = (enum role)bench_choice_opt(argv, optarg, roles);
             have_role = 1;
-            role = (enum role)k;
-            bad = k < 0;
             break;
-        }
-        case OPT_WAIT: {
-            static const char *const waits[] = {"spin", "waitset", NULL}; /* enum waitmode */
-            int k = bench_choice(optarg, waits);
-            n.wait = (enum waitmode)k;
-            bad = k < 0;
-            break;
-        }
+        case OPT_WAIT: n.wait = (enum waitmode)bench_choice_opt(argv, optarg, waits); break;
         case OPT_PERSIST: persist = 1; break;
-        case OPT_START:
-            bad = bench_parse_u64(optarg, &u) != 0;
-            start_wait = (int64_t)u * 1000000LL;
-            break;
-        case OPT_HELP: usage(stdout); return 0;
-        default:
-            if (!bad) {
-                usage(stderr);
-                return BENCH_EXIT_USAGE;
-            }
-        }
-        if (bad) {
-            fprintf(stderr, "bad value for option: %s\n", optarg ? optarg : "");
-            return BENCH_EXIT_USAGE;
+        case OPT_START: start_wait = bench_ms_opt(argv, optarg, 1); break;
         }
     }
-    if (!have_role || optind != argc) {
+    if (!have_role) {
         usage(stderr);
         return BENCH_EXIT_USAGE;
     }

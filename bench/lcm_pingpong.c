@@ -142,50 +142,27 @@ int main(int argc, char **argv)
     const char *url = DEFAULT_URL;
     int have_role = 0;
     int64_t start_wait = 10000000000LL;
-    enum { OPT_ROLE = 0x200, OPT_URL, OPT_PERSIST, OPT_START, OPT_HELP };
+    enum { OPT_ROLE = 0x200, OPT_URL, OPT_PERSIST, OPT_START };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"role", required_argument, 0, OPT_ROLE},
                                              {"url", required_argument, 0, OPT_URL},
                                              {"persist", no_argument, 0, OPT_PERSIST},
                                              {"start-wait-ms", required_argument, 0, OPT_START},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
     int opt;
-    uint64_t u;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int r = bench_common_opt(&c.o, opt, optarg);
-        if (r == 1)
-            continue;
-        if (r < 0) {
-            fprintf(stderr, "bad value for option: %s\n", optarg);
-            return BENCH_EXIT_USAGE;
-        }
+    while ((opt = bench_next_opt(argc, argv, longopts, &c.o, usage)) != -1) {
         switch (opt) {
-        case OPT_ROLE: {
-            static const char *const roles[] = {"echo", "ping", NULL}; /* enum role */
-            int k = bench_choice(optarg, roles);
-            if (k < 0) {
-                fprintf(stderr, "unknown role %s\n", optarg);
-                return BENCH_EXIT_USAGE;
-            }
+        case OPT_ROLE:
+            c.role = (enum role)bench_choice_opt(argv, optarg, roles);
             have_role = 1;
-            c.role = (enum role)k;
             break;
-        }
         case OPT_URL: url = optarg; break;
         case OPT_PERSIST: c.persist = 1; break;
-        case OPT_START:
-            if (bench_parse_u64(optarg, &u)) {
-                fprintf(stderr, "bad --start-wait-ms\n");
-                return BENCH_EXIT_USAGE;
-            }
-            start_wait = (int64_t)u * 1000000LL;
-            break;
-        case OPT_HELP: usage(stdout); return 0;
-        default: usage(stderr); return BENCH_EXIT_USAGE;
+        case OPT_START: start_wait = bench_ms_opt(argv, optarg, 1); break;
         }
     }
-    if (!have_role || optind != argc) {
+    if (!have_role) {
         usage(stderr);
         return BENCH_EXIT_USAGE;
     }

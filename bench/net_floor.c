@@ -540,7 +540,7 @@ int main(int argc, char **argv)
     int have_t = 0, have_r = 0, have_bind = 0;
     enum {
         OPT_T = 0x200, OPT_ROLE, OPT_IF, OPT_ET, OPT_DST, OPT_BIND, OPT_PEER, OPT_PERSIST, OPT_IDLE, OPT_START,
-        OPT_LIMIT, OPT_HELP
+        OPT_LIMIT
     };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"transport", required_argument, 0, OPT_T},
@@ -554,36 +554,26 @@ int main(int argc, char **argv)
                                              {"echo-limit", required_argument, 0, OPT_LIMIT},
                                              {"idle-ms", required_argument, 0, OPT_IDLE},
                                              {"start-wait-ms", required_argument, 0, OPT_START},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const transports[] = {"raw", "udp", NULL};           /* enum transport */
+    static const char *const roles[] = {"echo", "ping", "source", "sink", NULL}; /* enum role */
     int opt;
     uint64_t u;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int c = bench_common_opt(&r.o, opt, optarg);
-        if (c == 1)
-            continue;
-        int bad = c < 0;
+    while ((opt = bench_next_opt(argc, argv, longopts, &r.o, usage)) != -1) {
+        int bad = 0;
         switch (opt) {
         case OPT_T:
+            r.ep.t = (enum transport)bench_choice_opt(argv, optarg, transports);
             have_t = 1;
-            if (!strcmp(optarg, "raw"))
-                r.ep.t = T_RAW;
-            else if (!strcmp(optarg, "udp"))
-                r.ep.t = T_UDP;
-            else
-                bad = 1;
             break;
-        case OPT_ROLE: {
-            static const char *const roles[] = {"echo", "ping", "source", "sink", NULL}; /* enum role */
-            int k = bench_choice(optarg, roles);
+        case OPT_ROLE:
+            r.role = (enum role)bench_choice_opt(argv, optarg, roles);
             have_r = 1;
-            r.role = (enum role)k;
-            bad = k < 0;
             break;
-        }
         case OPT_IF: r.ep.ifname = optarg; break;
         case OPT_ET:
-            bad = bench_parse_u64(optarg, &u) || u < 0x0600 || u > 0xFFFF;
+            if (bench_parse_u64(optarg, &u) || u < 0x0600 || u > 0xFFFF)
+                bench_bad_value(argv, optarg);
             r.ep.ethertype = (uint16_t)u;
             break;
         case OPT_DST:
@@ -600,27 +590,13 @@ int main(int argc, char **argv)
             break;
         case OPT_PERSIST: r.persist = 1; break;
         case OPT_LIMIT: bad = bench_parse_u64(optarg, &r.echo_limit) != 0; break;
-        case OPT_IDLE:
-            bad = bench_parse_u64(optarg, &u) != 0;
-            r.idle_ns = (int64_t)u * 1000000LL;
-            break;
-        case OPT_START:
-            bad = bench_parse_u64(optarg, &u) != 0;
-            r.start_wait_ns = (int64_t)u * 1000000LL;
-            break;
-        case OPT_HELP: usage(stdout); return 0;
-        default:
-            if (!bad) {
-                usage(stderr);
-                return BENCH_EXIT_USAGE;
-            }
+        case OPT_IDLE: r.idle_ns = bench_ms_opt(argv, optarg, 1); break;
+        case OPT_START: r.start_wait_ns = bench_ms_opt(argv, optarg, 1); break;
         }
-        if (bad) {
-            fprintf(stderr, "bad value for option %s: %s\n", argv[optind - 1], optarg ? optarg : "");
-            return BENCH_EXIT_USAGE;
-        }
+        if (bad)
+            bench_bad_value(argv, optarg);
     }
-    if (optind != argc || !have_t || !have_r) {
+    if (!have_t || !have_r) {
         usage(stderr);
         return BENCH_EXIT_USAGE;
     }

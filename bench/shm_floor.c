@@ -161,43 +161,15 @@ int main(int argc, char **argv)
     bench_opts_defaults(&o, NULL, 8, 100000);
     o.warmup = 1000;
     enum mode m = MODE_SPIN;
-    enum { OPT_MODE = 0x200, OPT_HELP };
+    enum { OPT_MODE = 0x200 };
     static const struct option longopts[] = {BENCH_COMMON_LONGOPTS,
                                              {"mode", required_argument, 0, OPT_MODE},
-                                             {"help", no_argument, 0, OPT_HELP},
                                              {0, 0, 0, 0}};
+    static const char *const modes[] = {"spin", "futex", "eventfd", NULL}; /* enum mode */
     int opt;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-        int r = bench_common_opt(&o, opt, optarg);
-        if (r == 1)
-            continue;
-        if (r < 0) {
-            fprintf(stderr, "bad value for option: %s\n", optarg);
-            return BENCH_EXIT_USAGE;
-        }
-        if (opt == OPT_MODE) {
-            if (!strcmp(optarg, "spin"))
-                m = MODE_SPIN;
-            else if (!strcmp(optarg, "futex"))
-                m = MODE_FUTEX;
-            else if (!strcmp(optarg, "eventfd"))
-                m = MODE_EVENTFD;
-            else {
-                fprintf(stderr, "unknown mode %s\n", optarg);
-                return BENCH_EXIT_USAGE;
-            }
-        } else if (opt == OPT_HELP) {
-            usage(stdout);
-            return 0;
-        } else {
-            usage(stderr);
-            return BENCH_EXIT_USAGE;
-        }
-    }
-    if (optind != argc) {
-        usage(stderr);
-        return BENCH_EXIT_USAGE;
-    }
+    while ((opt = bench_next_opt(argc, argv, longopts, &o, usage)) != -1)
+        if (opt == OPT_MODE)
+            m = (enum mode)bench_choice_opt(argv, optarg, modes);
     if (o.payload > MAX_SHM_PAYLOAD) {
         fprintf(stderr, "payload at most %d bytes\n", MAX_SHM_PAYLOAD);
         return BENCH_EXIT_USAGE;

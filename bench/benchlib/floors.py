@@ -14,11 +14,10 @@ two namespaces).
 import os
 import re
 import shutil
-import subprocess
 import time
 from dataclasses import dataclass, field
 
-from . import procs, results
+from . import procs
 from .procs import Failed, Skip
 
 PROGRAMS = ("shm_floor", "net_floor", "lcm_pingpong", "iox_pingpong", "dds_pingpong")
@@ -261,57 +260,26 @@ def run_net(ctx, case):
         link_a = ["--transport", "udp", "--peer", "%s:47900" % ns.IP_B]
         link_b = ["--transport", "udp", "--bind", "%s:47900" % ns.IP_B]
     if case.opts["role"] == "rtt":
-        echo = procs.start_background(
+        return procs.ping_with_echo(
             ns.wrap("b", [exe, "--role", "echo", "--idle-ms", "60000"] + link_b + ctx.side_opts("b")),
-            ctx.log(case, "echo"))
-        try:
-            row = procs.run_measurement(
-                ns.wrap("a", [exe, "--role", "ping"] + link_a + ctx.common(case) + ctx.side_opts("a")),
-                _timeout(case), ctx.log(case, "ping"))
-        finally:
-            procs.stop(echo)  # it exits by itself on the ping's FIN
-            procs.forget(echo)
-        return row
+            ctx.log(case, "echo"),
+            ns.wrap("a", [exe, "--role", "ping"] + link_a + ctx.common(case) + ctx.side_opts("a")),
+            _timeout(case), ctx.log(case, "ping"))
     # One-way: the sink (ns b) measures and prints the row; the source (ns a) only sends.
-    sink_out = ctx.log(case, "sink")
-    sink = procs.start_background(
-        ns.wrap("b", [exe, "--role", "sink"] + link_b + ctx.common(case) + ctx.side_opts("b")), sink_out)
-    try:
-        cp = subprocess.run(ns.wrap("a", [exe, "--role", "source"] + link_a + ctx.common(case)[:-2]
-                                    + ctx.side_opts("a")),
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            timeout=_timeout(case), stdin=subprocess.DEVNULL)
-        with open(ctx.log(case, "source"), "w") as f:
-            f.write("$ %s\n%s" % (" ".join(cp.args), cp.stdout))
-        if cp.returncode == procs.EXIT_SKIP:
-            raise Skip(cp.stdout.strip().splitlines()[-1] if cp.stdout.strip() else "skipped")
-        if cp.returncode != 0:
-            raise Failed("source exited %d: %s" % (cp.returncode, cp.stdout.strip()[-300:]))
-        rc = sink.wait(timeout=15)  # exits on the FIN (or its idle timeout)
-    except subprocess.TimeoutExpired as e:
-        raise Failed("one-way run timed out") from e
-    finally:
-        procs.stop(sink, grace=0.5)
-        procs.forget(sink)
-    with open(sink_out, errors="replace") as f:
-        text = f.read()
-    if rc != 0:
-        raise Failed("sink exited %d: %s" % (rc, text.strip()[-300:]))
-    return results.parse_program_output(text)
+    return procs.source_to_sink(
+        ns.wrap("b", [exe, "--role", "sink"] + link_b + ctx.common(case) + ctx.side_opts("b")), ctx.log(case, "sink"),
+        ns.wrap("a", [exe, "--role", "source"] + link_a + ctx.common(case)[:-2] + ctx.side_opts("a")),
+        ctx.log(case, "source"), _timeout(case))
 
 
 def run_lcm(ctx, case):
     exe = ctx.prog("lcm_pingpong")
     ns = ctx.netns()
     echo_side = "b" if case.opts["placement"] == "netns" else "a"
-    echo = procs.start_background(ns.wrap(echo_side, [exe, "--role", "echo"] + ctx.side_opts("b")),
-                                  ctx.log(case, "echo"))
-    try:
-        row = procs.run_measurement(ns.wrap("a", [exe, "--role", "ping"] + ctx.common(case) + ctx.side_opts("a")),
-                                    _timeout(case), ctx.log(case, "ping"))
-    finally:
-        procs.stop(echo)
-        procs.forget(echo)
+    row = procs.ping_with_echo(ns.wrap(echo_side, [exe, "--role", "echo"] + ctx.side_opts("b")),
+                               ctx.log(case, "echo"),
+                               ns.wrap("a", [exe, "--role", "ping"] + ctx.common(case) + ctx.side_opts("a")),
+                               _timeout(case), ctx.log(case, "ping"))
     row["placement"] = case.opts["placement"]
     return row
 
@@ -320,14 +288,9 @@ def run_iox(ctx, case):
     exe = ctx.prog("iox_pingpong")
     ctx.roudi()
     w = ["--wait", case.opts["wait"]]
-    echo = procs.start_background([exe, "--role", "echo"] + w + ctx.side_opts("b"), ctx.log(case, "echo"))
-    try:
-        row = procs.run_measurement([exe, "--role", "ping", "--half"] + w + ctx.common(case) + ctx.side_opts("a"),
-                                    _timeout(case), ctx.log(case, "ping"))
-    finally:
-        procs.stop(echo)
-        procs.forget(echo)
-    return row
+    return procs.ping_with_echo([exe, "--role", "echo"] + w + ctx.side_opts("b"), ctx.log(case, "echo"),
+                                [exe, "--role", "ping", "--half"] + w + ctx.common(case) + ctx.side_opts("a"),
+                                _timeout(case), ctx.log(case, "ping"))
 
 
 # kind -> runner(ctx, case) returning a schema row; scripts/bench adds its ccomm kinds here.

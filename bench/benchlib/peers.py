@@ -18,7 +18,7 @@ import json
 import os
 import subprocess
 
-from . import procs, results
+from . import procs
 from .procs import Failed, Skip
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -161,48 +161,22 @@ def run_net_peer(ctx, case):
     common = ctx.common(case)
     if case.opts["role"] == "rtt":
         echo_log = ctx.log(case, "echo")
-        echo = procs.start_background(ns.wrap("b", _net_argv(ctx, case, "b") + ["--role", "echo", "--idle-ms",
-                                                                                  "30000"] + ctx.side_opts("b")),
-                                      echo_log)
-        try:
-            row = procs.run_measurement(ns.wrap("a", _net_argv(ctx, case, "a") + ["--role", "ping"] + common +
-                                                ctx.side_opts("a")), _timeout(case), ctx.log(case, "ping"))
-            echo.wait(timeout=10)  # it exits on the ping's FIN and prints its CPU time
-        except Exception:
-            procs.stop(echo)
-            raise
-        finally:
-            procs.forget(echo)
+        row = procs.ping_with_echo(
+            ns.wrap("b", _net_argv(ctx, case, "b") + ["--role", "echo", "--idle-ms", "30000"] + ctx.side_opts("b")),
+            echo_log, ns.wrap("a", _net_argv(ctx, case, "a") + ["--role", "ping"] + common + ctx.side_opts("a")),
+            _timeout(case), ctx.log(case, "ping"), echo_exit=10)
         return _add_cpu(row, partner_cpu(echo_log))
     return _one_way(ctx, case, common)
 
 
 def _one_way(ctx, case, common):
     ns = ctx.netns()
-    sink_log = ctx.log(case, "sink")
-    sink = procs.start_background(ns.wrap("b", _net_argv(ctx, case, "b") + ["--role", "sink", "--idle-ms", "5000"]
-                                          + common + ctx.side_opts("b")), sink_log)
     src_log = ctx.log(case, "source")
-    try:
-        with open(src_log, "w") as f:
-            cp = subprocess.run(ns.wrap("a", _net_argv(ctx, case, "a") + ["--role", "source"] + common[:-2] +
-                                        ctx.side_opts("a")), stdout=f, stderr=subprocess.STDOUT, text=True,
-                                timeout=_timeout(case), stdin=subprocess.DEVNULL)
-        if cp.returncode == procs.EXIT_SKIP:
-            raise Skip("source skipped (see %s)" % src_log)
-        if cp.returncode != 0:
-            raise Failed("source exited %d (see %s)" % (cp.returncode, src_log))
-        rc = sink.wait(timeout=20)
-    except subprocess.TimeoutExpired as e:
-        raise Failed("one-way run timed out") from e
-    finally:
-        procs.stop(sink, grace=0.5)
-        procs.forget(sink)
-    with open(sink_log, errors="replace") as f:
-        text = f.read()
-    if rc != 0:
-        raise Failed("sink exited %d: %s" % (rc, text.strip()[-300:]))
-    row = results.parse_program_output(text)
+    row = procs.source_to_sink(
+        ns.wrap("b", _net_argv(ctx, case, "b") + ["--role", "sink", "--idle-ms", "5000"] + common + ctx.side_opts("b")),
+        ctx.log(case, "sink"),
+        ns.wrap("a", _net_argv(ctx, case, "a") + ["--role", "source"] + common[:-2] + ctx.side_opts("a")),
+        src_log, _timeout(case), sink_exit=20)
     return _add_cpu(row, partner_cpu(src_log))
 
 
@@ -224,17 +198,9 @@ def run_iox2(ctx, case):
     svc = "ccb-%d-%s" % (os.getpid(), case.name)
     w = ["--wait", case.opts["wait"], "--service", svc]
     echo_log = ctx.log(case, "echo")
-    echo = procs.start_background([exe, "--role", "echo", "--payload", str(case.payload)] + w + ctx.side_opts("b"),
-                                  echo_log)
-    try:
-        row = procs.run_measurement([exe, "--role", "ping", "--half"] + w + ctx.common(case) + ctx.side_opts("a"),
-                                    20 + 3 * case.est_seconds(), ctx.log(case, "ping"))
-        echo.wait(timeout=10)
-    except Exception:
-        procs.stop(echo)
-        raise
-    finally:
-        procs.forget(echo)
+    row = procs.ping_with_echo([exe, "--role", "echo", "--payload", str(case.payload)] + w + ctx.side_opts("b"),
+                               echo_log, [exe, "--role", "ping", "--half"] + w + ctx.common(case) + ctx.side_opts("a"),
+                               20 + 3 * case.est_seconds(), ctx.log(case, "ping"), echo_exit=10)
     return _add_cpu(row, partner_cpu(echo_log))
 
 

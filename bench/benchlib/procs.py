@@ -98,6 +98,50 @@ def run_measurement(argv, timeout, log_path=None):
     return results.parse_program_output(cp.stdout)
 
 
+def ping_with_echo(echo_argv, echo_log, ping_argv, timeout, ping_log, echo_exit=2.0):
+    """Round trips: the echo in the background, the ping measuring in the foreground.
+
+    The echo gets `echo_exit` s to exit by itself on the ping's FIN (and print what it
+    prints last, e.g. its CPU time), then it is ended. Returns the ping's row.
+    """
+    echo = start_background(echo_argv, echo_log)
+    try:
+        return run_measurement(ping_argv, timeout, ping_log)
+    finally:
+        stop(echo, grace=echo_exit)
+        forget(echo)
+
+
+def source_to_sink(sink_argv, sink_log, source_argv, source_log, timeout, sink_exit=15.0):
+    """One way: the sink in the background measures and prints the row, the source in the
+    foreground only sends, then a FIN; the sink gets `sink_exit` s to exit on it (or on
+    its idle timeout). Both logs start with the command. Returns the sink's row.
+    """
+    def tail(path):
+        with open(path, errors="replace") as f:
+            return f.read().strip()
+    sink = start_background(sink_argv, sink_log)
+    try:
+        with open(source_log, "w") as f:
+            f.write("$ %s\n" % " ".join(source_argv))
+            f.flush()
+            rc = subprocess.run(source_argv, stdout=f, stderr=subprocess.STDOUT, timeout=timeout,
+                                stdin=subprocess.DEVNULL).returncode
+        if rc == EXIT_SKIP:
+            raise Skip(tail(source_log).splitlines()[-1])
+        if rc != 0:
+            raise Failed("source exited %d: %s" % (rc, tail(source_log)[-300:]))
+        rc = sink.wait(timeout=sink_exit)
+    except subprocess.TimeoutExpired as e:
+        raise Failed("one-way run timed out") from e
+    finally:
+        stop(sink, grace=0.5)
+        forget(sink)
+    if rc != 0:
+        raise Failed("sink exited %d: %s" % (rc, tail(sink_log)[-300:]))
+    return results.parse_program_output(tail(sink_log))
+
+
 def wait_for_text(path, text, timeout, proc=None):
     """Poll a log file until it contains `text`; False on timeout or if `proc` died."""
     end = time.monotonic() + timeout

@@ -68,16 +68,13 @@ def run_pingpong(ctx, case):
             floor_shm = "/ccbench-floor-%d-%s" % (os.getpid(), case.name)
             exe += ["--floor-shm", floor_shm, "--block", "1000"]
         cpu0 = _cpu_mark(d, [ccomm.LOCAL_NODE])
-        echo = procs.start_background(exe + ["--role", "echo"] + ctx.side_opts("b"),
-                                      os.path.join(ctx.workdir, case.name + ".echo.log"))
+        argv = exe + ["--role", "ping", "--half", "--name", case.name, "--count", str(o["count"]),
+                      "--warmup", "1000", "--dump", os.path.join(ctx.rawdir, case.name + ".tsv")] + ctx.side_opts("a")
         try:
-            argv = exe + ["--role", "ping", "--half", "--name", case.name, "--count", str(o["count"]),
-                          "--warmup", "1000", "--dump", os.path.join(ctx.rawdir, case.name + ".tsv")] + \
-                ctx.side_opts("a")
-            row = procs.run_measurement(argv, 60, os.path.join(ctx.workdir, case.name + ".ping.log"))
+            row = procs.ping_with_echo(exe + ["--role", "echo"] + ctx.side_opts("b"),
+                                       os.path.join(ctx.workdir, case.name + ".echo.log"),
+                                       argv, 60, os.path.join(ctx.workdir, case.name + ".ping.log"))
         finally:
-            procs.stop(echo)
-            procs.forget(echo)
             if floor_shm and os.path.exists("/dev/shm" + floor_shm):
                 os.unlink("/dev/shm" + floor_shm)  # the ping removes it; not after a failure
         cpu_ns = _cpu_since(d, [ccomm.LOCAL_NODE], cpu0)

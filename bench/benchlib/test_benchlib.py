@@ -45,6 +45,26 @@ def free_udp_port():
         return s.getsockname()[1]
 
 
+def run_beside(partner_argv, main_argv, timeout=60, partner_exit=30, env=None):
+    """Runs main_argv while partner_argv (an echo or a sink) runs beside it, then gives the
+    partner `partner_exit` s to exit by itself (on the FIN) before killing it. Returns
+    both as CompletedProcess (text, stdout and stderr captured)."""
+    partner = subprocess.Popen(partner_argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        main = subprocess.run(main_argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              timeout=timeout)
+    except BaseException:
+        partner.kill()
+        partner.communicate()
+        raise
+    try:
+        out, err = partner.communicate(timeout=partner_exit)
+    except subprocess.TimeoutExpired:
+        partner.kill()
+        out, err = partner.communicate()
+    return main, subprocess.CompletedProcess(partner_argv, partner.returncode, out, err)
+
+
 class StatsTest(unittest.TestCase):
     def test_nearest_rank(self):
         v = list(range(1, 101))  # 1..100
@@ -180,19 +200,12 @@ class ProgramTest(unittest.TestCase):
 
     def _udp_pair(self, port, ping_args, echo_args=()):
         exe = prog("net_floor")
-        echo = subprocess.Popen([exe, "--transport", "udp", "--role", "echo", "--bind", "127.0.0.1:%d" % port]
-                                + list(echo_args), stderr=subprocess.PIPE, text=True)
-        try:
-            ping = subprocess.run([exe, "--transport", "udp", "--role", "ping", "--peer", "127.0.0.1:%d" % port]
-                                  + ping_args, stdout=subprocess.PIPE, text=True, timeout=60)
-            return ping.returncode, ping.stdout
-        finally:
-            try:
-                echo.wait(timeout=3)  # exits on the ping's FIN (or its --echo-limit)
-            except subprocess.TimeoutExpired:
-                echo.kill()
-                echo.wait()
-            echo.stderr.close()
+        # The echo exits on the ping's FIN (or its --echo-limit).
+        ping, _ = run_beside([exe, "--transport", "udp", "--role", "echo", "--bind", "127.0.0.1:%d" % port]
+                             + list(echo_args),
+                             [exe, "--transport", "udp", "--role", "ping", "--peer", "127.0.0.1:%d" % port] + ping_args,
+                             partner_exit=3)
+        return ping.returncode, ping.stdout
 
     def test_udp_loopback_rtt(self):
         with tempfile.TemporaryDirectory() as d:
@@ -236,19 +249,11 @@ class ProgramTest(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             dump = os.path.join(d, "o.tsv")
             common = ["--transport", "udp", "--rate", "2000", "--count", "400", "--warmup", "10", "--payload", "72"]
-            sink = subprocess.Popen([exe, "--role", "sink", "--bind", "127.0.0.1:%d" % port, "--dump", dump] + common,
-                                    stdout=subprocess.PIPE, text=True)
-            try:
-                src = subprocess.run([exe, "--role", "source", "--peer", "127.0.0.1:%d" % port] + common,
-                                     stderr=subprocess.PIPE, text=True, timeout=60)
-                out, _ = sink.communicate(timeout=30)
-            finally:
-                if sink.poll() is None:
-                    sink.kill()
-                    sink.wait()
-            self.assertEqual(src.returncode, 0)
-            self.assertEqual(sink.returncode, 0)
-            row = results.parse_program_output(out)
+            src, sink = run_beside([exe, "--role", "sink", "--bind", "127.0.0.1:%d" % port, "--dump", dump] + common,
+                                   [exe, "--role", "source", "--peer", "127.0.0.1:%d" % port] + common)
+            self.assertEqual(src.returncode, 0, src.stderr)
+            self.assertEqual(sink.returncode, 0, sink.stderr)
+            row = results.parse_program_output(sink.stdout)
             self.assertEqual(row["metric"], "one_way")
             self.assertEqual(row["sent"], 410)
             self.assertGreater(row["min_ns"], 0)
@@ -259,19 +264,11 @@ class ProgramTest(unittest.TestCase):
         exe = prog("net_floor")
         pair = procs.NetnsPair("ccbt%d" % (os.getpid() % 10000))
         with pair:
-            echo = subprocess.Popen(pair.wrap("b", [exe, "--transport", "raw", "--role", "echo", "--if", "eth0"]),
-                                    stderr=subprocess.DEVNULL)
-            try:
-                cp = subprocess.run(pair.wrap("a", [exe, "--transport", "raw", "--role", "ping", "--if", "eth0",
-                                                    "--rate", "0", "--count", "300", "--payload", "8"]),
-                                    stdout=subprocess.PIPE, text=True, timeout=60)
-            finally:
-                try:
-                    echo.wait(timeout=3)
-                except subprocess.TimeoutExpired:
-                    echo.kill()
-                    echo.wait()
-        self.assertEqual(cp.returncode, 0)
+            cp, _ = run_beside(pair.wrap("b", [exe, "--transport", "raw", "--role", "echo", "--if", "eth0"]),
+                               pair.wrap("a", [exe, "--transport", "raw", "--role", "ping", "--if", "eth0",
+                                               "--rate", "0", "--count", "300", "--payload", "8"]),
+                               partner_exit=3)
+        self.assertEqual(cp.returncode, 0, cp.stderr)
         row = results.parse_program_output(cp.stdout)
         self.assertEqual((row["transport"], row["count"], row["lost"], row["wire_bytes"]), ("raw", 300, 0, 60))
         # The namespaces are gone again.
@@ -300,10 +297,6 @@ class DriverTest(unittest.TestCase):
                 self.assertTrue(os.path.exists(os.path.join(d, r["raw"])))
 
 
-if __name__ == "__main__":
-    unittest.main()
-
-
 class DdsPeerTest(unittest.TestCase):
     """dds_pingpong (Cyclone DDS) on loopback: its statistics agree with its raw dump,
     a round trip is two values, and bad usage is refused."""
@@ -312,22 +305,13 @@ class DdsPeerTest(unittest.TestCase):
         from . import peers
         exe = prog("dds_pingpong")
         env = dict(os.environ, CYCLONEDDS_URI=peers.dds_config("127.0.0.1", "lo", tag))
-        partner = subprocess.Popen([exe, "--role", roles[0], "--idle-ms", "20000"] + args, env=env,
-                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        try:
-            main = subprocess.run([exe, "--role", roles[1]] + args, env=env, stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True, timeout=90)
-            pout, perr = partner.communicate(timeout=30)
-        finally:
-            if partner.poll() is None:
-                partner.kill()
-                partner.wait()
-        return main, pout, perr
+        return run_beside([exe, "--role", roles[0], "--idle-ms", "20000"] + args, [exe, "--role", roles[1]] + args,
+                          timeout=90, env=env)
 
     def test_ping_echo_rtt(self):
         with tempfile.TemporaryDirectory() as d:
             dump = os.path.join(d, "d.tsv")
-            main, _, perr = self._run_pair(("echo", "ping"), ["--rate", "0", "--count", "300", "--warmup", "20",
+            main, echo = self._run_pair(("echo", "ping"), ["--rate", "0", "--count", "300", "--warmup", "20",
                                                                "--dump", dump, "--reliable"],
                                            "t%d" % os.getpid())
             self.assertEqual(main.returncode, 0, main.stderr)
@@ -336,28 +320,16 @@ class DdsPeerTest(unittest.TestCase):
             self.assertEqual(row["count"] + row["lost"], 300)
             self.assertEqual(row["values"], 2 * (row["count"] + 20))
             self.assertGreater(row["cpu_ns"], 0)
-            self.assertIn('"cpu_ns"', perr)  # the echo's CPU time, for CPU per value
+            self.assertIn('"cpu_ns"', echo.stderr)  # the echo's CPU time, for CPU per value
             ProgramTest.check_against_dump(self, row, dump)
 
     def test_source_sink_one_way(self):
         with tempfile.TemporaryDirectory() as d:
             dump = os.path.join(d, "s.tsv")
             args = ["--rate", "2000", "--count", "400", "--warmup", "20", "--payload", "288"]
-            exe = prog("dds_pingpong")
-            from . import peers
-            env = dict(os.environ, CYCLONEDDS_URI=peers.dds_config("127.0.0.1", "lo", "s%d" % os.getpid()))
-            sink = subprocess.Popen([exe, "--role", "sink", "--idle-ms", "20000", "--dump", dump] + args, env=env,
-                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-            try:
-                src = subprocess.run([exe, "--role", "source"] + args, env=env, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, timeout=90)
-                out, _ = sink.communicate(timeout=30)
-            finally:
-                if sink.poll() is None:
-                    sink.kill()
-                    sink.wait()
+            src, sink = self._run_pair(("sink", "source"), args + ["--dump", dump], "s%d" % os.getpid())
             self.assertEqual(src.returncode, 0, src.stderr)
-            row = results.parse_program_output(out)
+            row = results.parse_program_output(sink.stdout)
             self.assertEqual(row["metric"], "one_way")
             self.assertEqual(row["payload_bytes"], 288)
             self.assertEqual(row["count"] + row["lost"], 400)
@@ -368,3 +340,7 @@ class DdsPeerTest(unittest.TestCase):
         exe = prog("dds_pingpong")
         for args in ([], ["--role", "x"], ["--role", "ping", "--idle-ms", "0"], ["--role", "sink", "extra"]):
             self.assertEqual(subprocess.run([exe] + args, stderr=subprocess.DEVNULL).returncode, 2, args)
+
+
+if __name__ == "__main__":
+    unittest.main()

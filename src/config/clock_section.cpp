@@ -12,11 +12,7 @@ void Parser::ClockElement(const Node* n, ClockConfig* out) {
   Element e(n, {"domain", "grandmaster", "timestamping", "sync_interval_log", "socket"}, &diag_);
   out->present = true;
   out->line = e.line();
-  CheckNoText(n, &diag_);
-  for (const Node* c = n->first_node(); c; c = c->next_sibling())
-    if (c->type() == rapidxml::node_element)
-      Err(diag_.LineOf(c->name()), "unknown element <" + std::string(NameOf(c)) +
-                                       "> in <clock> (it has attributes only)");
+  CheckAttributesOnly(n, &diag_);
   Unsigned(e, "domain", 0, 127, &out->domain);  // 128..255 are reserved by IEEE 1588
   if (const AttrValue* a = e.Get("grandmaster")) {
     std::vector<std::string_view> items;

@@ -52,9 +52,39 @@ void Names(std::string* o, const char* k, const std::vector<std::string>& v) {
   *o += "],";
 }
 
+void Bool(std::string* o, const char* k, bool v) {
+  Key(o, k);
+  *o += v ? "true," : "false,";
+}
+
 void Close(std::string* o, char bracket) {
   if (!o->empty() && o->back() == ',') o->pop_back();
   *o += bracket;
+}
+
+// "k":{...}, with the members `members()` writes.
+template <class Members>
+void Object(std::string* o, const char* k, Members&& members) {
+  Key(o, k);
+  *o += '{';
+  members();
+  Close(o, '}');
+  *o += ',';
+}
+
+// "k":[{...},...] of n objects, with the members `members(i)` writes for object i.
+template <class Members>
+void Objects(std::string* o, const char* k, size_t n, Members&& members) {
+  Key(o, k);
+  *o += '[';
+  for (size_t i = 0; i < n; ++i) {
+    *o += '{';
+    members(i);
+    Close(o, '}');
+    *o += ',';
+  }
+  Close(o, ']');
+  *o += ',';
 }
 
 }  // namespace
@@ -66,23 +96,17 @@ std::string ConfigToJson(const SystemConfig& cfg) {
   char hash[16];
   snprintf(hash, sizeof hash, "%08x", cfg.hash);
   Text(&o, "hash", hash);  // as ccommd --check and the frames' config hash field show it
-  Key(&o, "network");
-  o += '{';
-  Num(&o, "ethertype", cfg.network.ethertype);
-  Num(&o, "udp_port", cfg.network.udp_port);
-  Num(&o, "heartbeat_ms", cfg.network.heartbeat_ms);
-  Num(&o, "peer_timeout_ms", cfg.network.peer_timeout_ms);
-  Num(&o, "summary_ms", cfg.network.summary_ms);
-  Text(&o, "fanout", cfg.network.fanout == Fanout::kMulticast ? "multicast" : "unicast");
-  Key(&o, "authenticated");
-  o += cfg.network.auth_key_file.empty() ? "false," : "true,";
-  Close(&o, '}');
-  o += ',';
-  Key(&o, "nodes");
-  o += '[';
-  for (size_t n = 0; n < cfg.nodes.size(); ++n) {
+  Object(&o, "network", [&] {
+    Num(&o, "ethertype", cfg.network.ethertype);
+    Num(&o, "udp_port", cfg.network.udp_port);
+    Num(&o, "heartbeat_ms", cfg.network.heartbeat_ms);
+    Num(&o, "peer_timeout_ms", cfg.network.peer_timeout_ms);
+    Num(&o, "summary_ms", cfg.network.summary_ms);
+    Text(&o, "fanout", cfg.network.fanout == Fanout::kMulticast ? "multicast" : "unicast");
+    Bool(&o, "authenticated", !cfg.network.auth_key_file.empty());
+  });
+  Objects(&o, "nodes", cfg.nodes.size(), [&](size_t n) {
     const NodeConfig& node = cfg.nodes[n];
-    o += '{';
     Num(&o, "id", n);
     Text(&o, "name", node.name);
     Text(&o, "transport", node.transport == TransportKind::kUdp ? "udp" : "raw");
@@ -90,16 +114,9 @@ std::string ConfigToJson(const SystemConfig& cfg) {
     Text(&o, "ip", node.ip);
     Num(&o, "history", node.history);
     Num(&o, "line", static_cast<unsigned long long>(node.line));
-    Close(&o, '}');
-    o += ',';
-  }
-  Close(&o, ']');
-  o += ',';
-  Key(&o, "signals");
-  o += '[';
-  for (size_t s = 0; s < cfg.signals.size(); ++s) {
+  });
+  Objects(&o, "signals", cfg.signals.size(), [&](size_t s) {
     const SignalConfig& sig = cfg.signals[s];
-    o += '{';
     Num(&o, "id", s);
     Text(&o, "name", sig.name);
     Text(&o, "type", ValueTypeName(sig.type));
@@ -113,28 +130,19 @@ std::string ConfigToJson(const SystemConfig& cfg) {
     Num(&o, "stale_after_ms", sig.stale_after_ms);
     Num(&o, "period_us", sig.period_us);
     Num(&o, "queue_depth", sig.queue_depth);
-    Key(&o, "has_safe_value");
-    o += sig.has_safe_value ? "true," : "false,";
+    Bool(&o, "has_safe_value", sig.has_safe_value);
     Num(&o, "line", static_cast<unsigned long long>(sig.line));
-    Close(&o, '}');
-    o += ',';
-  }
-  Close(&o, ']');
-  o += ',';
-  Key(&o, "ros2");
-  o += '[';
-  for (const Ros2Config& r : cfg.ros2) {
-    o += '{';
+  });
+  Objects(&o, "ros2", cfg.ros2.size(), [&](size_t i) {
+    const Ros2Config& r = cfg.ros2[i];
     Text(&o, "node", r.node);
     Text(&o, "namespace", r.ros_namespace);
     if (r.has_domain) Num(&o, "domain", r.domain);
     if (r.publish_given) Names(&o, "publish", r.publish);
     Names(&o, "subscribe", r.subscribe);
-    Close(&o, '}');
-    o += ',';
-  }
-  Close(&o, ']');
-  o += "}\n";
+  });
+  Close(&o, '}');
+  o += '\n';
   return o;
 }
 

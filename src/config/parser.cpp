@@ -21,6 +21,13 @@ void CheckNoText(const Node* parent, Diagnostics* diag) {
                     "> (settings go in attributes)");
   }
 }
+void CheckAttributesOnly(const Node* parent, Diagnostics* diag) {
+  CheckNoText(parent, diag);
+  for (const Node* c = parent->first_node(); c; c = c->next_sibling())
+    if (c->type() == rapidxml::node_element)
+      diag->Error(diag->LineOf(c->name()), "unknown element <" + std::string(NameOf(c)) + "> in <" +
+                                               std::string(NameOf(parent)) + "> (it has attributes only)");
+}
 bool Parser::Name(const Element& e, const char* what, std::string* out) {
   const AttrValue* a = e.Get("name");
   if (a == nullptr) {

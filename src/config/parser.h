@@ -111,6 +111,8 @@ class Element {
 
 /// Reports text inside an element (everything in this format is an attribute).
 void CheckNoText(const Node* parent, Diagnostics* diag);
+/// Reports child elements of an element that has attributes only (and no text).
+void CheckAttributesOnly(const Node* parent, Diagnostics* diag);
 /// Reports "--" inside comments (xmllint and editors reject them).
 void CheckComments(const Node* parent, Diagnostics* diag);
 

@@ -25,11 +25,7 @@ bool RosToken(std::string_view s) {
 void Parser::Ros2Element(const Node* n, Ros2Config* out) {
   Element e(n, {"node", "namespace", "domain", "publish", "subscribe"}, &diag_);
   out->line = e.line();
-  CheckNoText(n, &diag_);
-  for (const Node* c = n->first_node(); c; c = c->next_sibling())
-    if (c->type() == rapidxml::node_element)
-      Err(diag_.LineOf(c->name()), "unknown element <" + std::string(NameOf(c)) +
-                                       "> in <ros2> (it has attributes only)");
+  CheckAttributesOnly(n, &diag_);
   if (const AttrValue* a = e.Get("node")) out->node = a->value;
   else if (!e.Has("node")) Err(e.line(), "<ros2> without node= (the node ccomm-ros2 runs on)");
   if (const AttrValue* a = e.Get("namespace")) {

@@ -23,6 +23,7 @@ source_fmu() {  # source_fmu NAME MAJOR: $WORK/NAME.fmu with sources/ and no bin
   mkdir -p "$d/sources"
   cp "$FMU_TEST_DIR/$name/modelDescription.xml" "$d/"
   cp "$FMU_TEST_DIR/$name/$name.c" "$d/sources/"
+  [[ $major == 3 ]] && cp "$FMU_TEST_DIR/fmi3_trivial.h" "$d/sources/"  # #included by the FMI 3.0 models
   [[ -f $FMU_TEST_DIR/$name/buildDescription.xml ]] && cp "$FMU_TEST_DIR/$name/buildDescription.xml" "$d/sources/"
   "$PY" "$FMU_TEST_DIR/gen_unsupported.py" "$FMPY_DIR/c-code" "$major" "$d/sources/$name.c" "$d/sources/unsupported.c"
   (cd "$d" && zip -q -r "$WORK/$name.fmu" .)

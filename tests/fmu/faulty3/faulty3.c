@@ -2,9 +2,8 @@
 // Test FMU (FMI 3.0): counts its steps on output "beat" until input "fault" asks it to fail:
 // 1 doStep returns Error, 2 Discard, 3 asks to terminate, 4 dereferences NULL (SIGSEGV).
 #include <stdlib.h>
-#include <string.h>
 
-#include "fmi3Functions.h"
+#include "fmi3_trivial.h"
 
 enum { VR_FAULT = 1, VR_BEAT = 2 };
 typedef struct {
@@ -14,7 +13,6 @@ typedef struct {
   fmi3InstanceEnvironment env;
 } Faulty;
 
-const char* fmi3GetVersion(void) { return fmi3Version; }
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,
                                          fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_return,
                                          const fmi3ValueReference required[], size_t n_required,
@@ -27,14 +25,6 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
   f->env = env;
   return f;
 }
-void fmi3FreeInstance(fmi3Instance i) { free(i); }
-fmi3Status fmi3EnterInitializationMode(fmi3Instance i, fmi3Boolean a, fmi3Float64 b, fmi3Float64 c, fmi3Boolean d,
-                                       fmi3Float64 e) {
-  (void)i; (void)a; (void)b; (void)c; (void)d; (void)e;
-  return fmi3OK;
-}
-fmi3Status fmi3ExitInitializationMode(fmi3Instance i) { (void)i; return fmi3OK; }
-fmi3Status fmi3Terminate(fmi3Instance i) { (void)i; return fmi3OK; }
 
 fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean no_set_prior, fmi3Boolean* event,
                       fmi3Boolean* terminate, fmi3Boolean* early, fmi3Float64* last) {

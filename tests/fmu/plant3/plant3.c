@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi3Functions.h"
+#include "fmi3_trivial.h"
 
 #ifndef SUBSTEPS
 #error "SUBSTEPS comes from sources/buildDescription.xml (a PreprocessorDefinition)"
@@ -18,8 +18,6 @@ typedef struct {
   float w[2];
   fmi3Boolean u_fresh;
 } Plant;
-
-const char* fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,
                                          fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_return,
@@ -39,14 +37,6 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
   p->u_fresh = fmi3True;
   return p;
 }
-void fmi3FreeInstance(fmi3Instance i) { free(i); }
-fmi3Status fmi3EnterInitializationMode(fmi3Instance i, fmi3Boolean a, fmi3Float64 b, fmi3Float64 c, fmi3Boolean d,
-                                       fmi3Float64 e) {
-  (void)i; (void)a; (void)b; (void)c; (void)d; (void)e;
-  return fmi3OK;
-}
-fmi3Status fmi3ExitInitializationMode(fmi3Instance i) { (void)i; return fmi3OK; }
-fmi3Status fmi3Terminate(fmi3Instance i) { (void)i; return fmi3OK; }
 fmi3Status fmi3Reset(fmi3Instance i) { (void)i; return fmi3Error; }
 
 fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean no_set_prior, fmi3Boolean* event,

@@ -2,7 +2,9 @@
 //! The Rust side of bench/bench_common.h, for the peer programs in bench/peers: the same
 //! command line (--name --payload --rate --count --warmup --timeout-ms --half --cpu
 //! --prio --no-mlock --dump), the same 24-byte message header, nearest-rank statistics
-//! and the same one-line JSON result, so scripts/bench treats them like the C programs.
+//! and the same one-line JSON result, so scripts/bench treats them like the C programs;
+//! and the echo, probe and ping loops, written once over the `Link` each peer implements
+//! for its middleware.
 //! libc is declared here by hand (a few calls) to keep the peers free of extra crates.
 
 use std::io::Write;
@@ -201,6 +203,106 @@ pub fn message(payload: usize) -> Vec<u8> {
     (0..HDR_SIZE + payload).map(|i| if i < HDR_SIZE { 0 } else { i as u8 }).collect()
 }
 
+// ---- the echo and ping sides, over any middleware ----
+
+/// What the echo, probe and ping loops need from a middleware: one publisher, one
+/// subscriber.
+pub trait Link {
+    fn send(&self, msg: &[u8]);
+    /// The next message into `buf` (replacing its contents); false at `deadline`.
+    /// `patient`: a long wait is expected (the partner may not have started), so the
+    /// link may poll slowly rather than spin.
+    fn recv(&mut self, buf: &mut Vec<u8>, deadline: i64, patient: bool) -> bool;
+}
+
+/// Send probes (seq = PROBE_SEQ, type `kind`) every 20 ms until one comes back as
+/// `answer` or `wait_ns` has passed; then drop late answers for 30 ms. True if answered:
+/// both directions are connected then.
+pub fn probe<L: Link>(l: &mut L, m: &mut [u8], kind: u32, answer: u32, wait_ns: i64) -> bool {
+    let give_up = now_ns() + wait_ns;
+    let mut b = Vec::with_capacity(m.len());
+    while now_ns() < give_up {
+        hdr_write(m, kind, PROBE_SEQ, now_ns());
+        l.send(m);
+        let until = now_ns() + 20_000_000;
+        while l.recv(&mut b, until, true) {
+            if matches!(hdr_read(&b), Some((k, PROBE_SEQ, _)) if k == answer) {
+                while l.recv(&mut b, now_ns() + 30_000_000, true) {}
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The echo: answers every ping with a pong of the same bytes until a FIN or `idle_ns`
+/// without a message; prints its partner line (pings echoed, CPU time from the first
+/// measured ping on).
+pub fn echo<L: Link>(l: &mut L, idle_ns: i64, max_len: usize) {
+    let (mut echoed, mut cpu0) = (0u64, 0i64);
+    let mut b = Vec::with_capacity(max_len);
+    while l.recv(&mut b, now_ns() + idle_ns, echoed == 0) {
+        match hdr_read(&b) {
+            Some((MSG_FIN, _, _)) => break,
+            Some((MSG_PING, seq, _)) => {
+                if seq != PROBE_SEQ && echoed == 0 {
+                    cpu0 = cpu_ns();
+                }
+                b[4..8].copy_from_slice(&MSG_PONG.to_le_bytes());
+                l.send(&b);
+                if seq != PROBE_SEQ {
+                    echoed += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    partner_line("echo", echoed, if echoed > 0 { cpu_ns() - cpu0 } else { 0 });
+}
+
+/// What the measured pings gave: round trips by sequence number (MISSING = no pong
+/// within --timeout-ms), pongs received, other messages, CPU time of the loop.
+pub struct PingRun {
+    pub samples: Vec<i64>,
+    pub received: u64,
+    pub foreign: u64,
+    pub cpu_ns: i64,
+}
+
+/// --warmup + --count pings in `m` at --rate (absolute sleeps; 0 = back to back), each
+/// waiting up to --timeout-ms for its pong (earlier pongs that come late still count).
+pub fn ping<L: Link>(l: &mut L, o: &Opts, m: &mut [u8]) -> PingRun {
+    let total = (o.warmup + o.count) as usize;
+    let mut r = PingRun { samples: vec![MISSING; total], received: 0, foreign: 0, cpu_ns: 0 };
+    let mut b = Vec::with_capacity(m.len());
+    let period = if o.rate_hz > 0.0 { (1e9 / o.rate_hz) as i64 } else { 0 };
+    let t0 = now_ns() + 1_000_000;
+    let cpu0 = cpu_ns();
+    for i in 0..total {
+        if period > 0 {
+            sleep_until_ns(t0 + i as i64 * period);
+        }
+        let ts = now_ns();
+        hdr_write(m, MSG_PING, i as u64, ts);
+        l.send(m);
+        while l.recv(&mut b, ts + o.timeout_ns, false) {
+            let tr = now_ns();
+            match hdr_read(&b) {
+                Some((MSG_PONG, seq, t)) if (seq as usize) < total && r.samples[seq as usize] == MISSING => {
+                    r.samples[seq as usize] = tr - t;
+                    r.received += 1;
+                    if seq as usize == i {
+                        break;
+                    }
+                }
+                _ => r.foreign += 1,
+            }
+        }
+    }
+    r.cpu_ns = cpu_ns() - cpu0;
+    r
+}
+
 // ---- samples and the result line ----
 
 /// Nearest-rank percentile of a sorted slice (bench_pct).
@@ -249,4 +351,95 @@ pub fn finish(o: &Opts, samples: &mut [i64], transport: &str, metric: &str, rt: 
 /// The partner's (echo, source) closing line on stderr: what it did and its CPU time.
 pub fn partner_line(role: &str, count: u64, cpu_ns: i64) {
     eprintln!("{{\"role\":\"{}\",\"count\":{},\"cpu_ns\":{}}}", role, count, cpu_ns);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::RefCell;
+    use std::collections::VecDeque;
+
+    /// An echo inside the link: every message sent comes back as a pong, except those
+    /// whose sequence number is in `drop`; `foreign` messages come before the first pong.
+    struct Loopback {
+        queue: RefCell<VecDeque<Vec<u8>>>,
+        drop: Vec<u64>,
+        foreign: usize,
+        sent: RefCell<u64>,
+    }
+
+    fn loopback(drop: Vec<u64>, foreign: usize) -> Loopback {
+        Loopback { queue: RefCell::new(VecDeque::new()), drop, foreign, sent: RefCell::new(0) }
+    }
+
+    impl Link for Loopback {
+        fn send(&self, msg: &[u8]) {
+            *self.sent.borrow_mut() += 1;
+            if !self.drop.contains(&hdr_read(msg).unwrap().1) {
+                let mut pong = msg.to_vec();
+                pong[4..8].copy_from_slice(&MSG_PONG.to_le_bytes());
+                self.queue.borrow_mut().push_back(pong);
+            }
+        }
+        fn recv(&mut self, buf: &mut Vec<u8>, deadline: i64, _patient: bool) -> bool {
+            if self.foreign > 0 {
+                self.foreign -= 1;
+                *buf = vec![0u8; HDR_SIZE];
+                return true;
+            }
+            match self.queue.borrow_mut().pop_front() {
+                Some(m) => {
+                    *buf = m;
+                    true
+                }
+                None => {
+                    sleep_until_ns(deadline);
+                    false
+                }
+            }
+        }
+    }
+
+    fn opts(count: u64, warmup: u64) -> Opts {
+        Opts { name: "t".into(), dump: None, cpu: None, prio: 0, payload: 8, rate_hz: 0.0, count, warmup,
+               timeout_ns: 1_000_000, half: false, no_mlock: true, extra: Vec::new() }
+    }
+
+    #[test]
+    fn ping_records_each_round_trip_and_counts_the_lost_and_the_foreign() {
+        let mut l = loopback(vec![3, 7], 1);
+        let o = opts(8, 2);
+        let mut m = message(o.payload);
+        let r = ping(&mut l, &o, &mut m);
+        assert_eq!(*l.sent.borrow(), 10);
+        assert_eq!((r.received, r.foreign), (8, 1));
+        let lost: Vec<usize> = (0..10).filter(|i| r.samples[*i] == MISSING).collect();
+        assert_eq!(lost, vec![3, 7]);
+        assert!(r.samples.iter().filter(|v| **v != MISSING).all(|v| *v >= 0));
+    }
+
+    #[test]
+    fn echo_answers_pings_until_the_fin() {
+        let mut l = loopback(vec![], 0);
+        let mut m = message(8);
+        for (kind, seq) in [(MSG_PING, PROBE_SEQ), (MSG_PING, 0), (MSG_DATA, 1), (MSG_PING, 2), (MSG_FIN, 3)] {
+            hdr_write(&mut m, kind, seq, now_ns());
+            l.queue.borrow_mut().push_back(m.clone());
+        }
+        echo(&mut l, 1_000_000_000, m.len());
+        assert_eq!(*l.sent.borrow(), 3); // the probe and the two pings, not the data message
+        let answers: Vec<_> = l.queue.borrow().iter().map(|b| hdr_read(b).unwrap()).collect();
+        assert_eq!(answers.iter().map(|a| (a.0, a.1)).collect::<Vec<_>>(),
+                   vec![(MSG_PONG, PROBE_SEQ), (MSG_PONG, 0), (MSG_PONG, 2)]);
+    }
+
+    #[test]
+    fn probe_is_answered_and_late_answers_are_dropped() {
+        let mut l = loopback(vec![], 0);
+        let mut m = message(8);
+        assert!(probe(&mut l, &mut m, MSG_PING, MSG_PONG, 1_000_000_000));
+        assert!(l.queue.borrow().is_empty());
+        let mut silent = loopback(vec![PROBE_SEQ], 0);
+        assert!(!probe(&mut silent, &mut m, MSG_PING, MSG_PONG, 50_000_000));
+    }
 }

@@ -13,7 +13,6 @@
 //! runtime too) over the measured window is printed as cpu_ns.
 
 use ccomm_bench_common as bc;
-use ccomm_bench_common::Link as _;
 use std::time::Duration;
 use zenoh::Wait;
 
@@ -29,34 +28,31 @@ fn session(o: &bc::Opts) -> zenoh::Session {
     zenoh::open(c).wait().unwrap_or_else(|e| bc::die(&format!("zenoh open: {}", e)))
 }
 
-struct PubSub {
+struct Link {
     tx: zenoh::pubsub::Publisher<'static>,
     rx: zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
 }
 
-fn link(s: &zenoh::Session, out: &'static str, inp: &'static str) -> PubSub {
+fn link(s: &zenoh::Session, out: &'static str, inp: &'static str) -> Link {
     let tx = s.declare_publisher(out).express(true).wait().unwrap_or_else(|e| bc::die(&format!("publisher: {}", e)));
     let rx = s.declare_subscriber(inp).wait().unwrap_or_else(|e| bc::die(&format!("subscriber: {}", e)));
-    PubSub { tx, rx }
+    Link { tx, rx }
 }
 
-impl bc::Link for PubSub {
+impl Link {
     fn send(&self, m: &[u8]) {
         self.tx.put(m.to_vec()).wait().unwrap_or_else(|e| bc::die(&format!("put: {}", e)));
     }
 
-    /// Blocks on the subscriber's channel: `patient` changes nothing here.
-    fn recv(&mut self, buf: &mut Vec<u8>, deadline: i64, _patient: bool) -> bool {
+    /// The next message's bytes, or None at `deadline`.
+    fn recv(&self, deadline: i64) -> Option<Vec<u8>> {
         let left = deadline - bc::now_ns();
         if left <= 0 {
-            return false;
+            return None;
         }
         match self.rx.recv_timeout(Duration::from_nanos(left as u64)) {
-            Ok(Some(s)) => {
-                *buf = s.payload().to_bytes().into_owned();
-                true
-            }
-            _ => false,
+            Ok(Some(s)) => Some(s.payload().to_bytes().into_owned()),
+            _ => None,
         }
     }
 }
@@ -74,24 +70,67 @@ fn main() {
     let mut m = bc::message(o.payload);
     let code = match role.as_str() {
         "echo" => {
-            bc::echo(&mut link(&s, "ccb/pong", "ccb/ping"), idle, m.len());
+            let l = link(&s, "ccb/pong", "ccb/ping");
+            let (mut echoed, mut cpu0) = (0u64, 0i64);
+            while let Some(mut b) = l.recv(bc::now_ns() + idle) {
+                match bc::hdr_read(&b) {
+                    Some((bc::MSG_FIN, _, _)) => break,
+                    Some((bc::MSG_PING, seq, _)) => {
+                        if seq != bc::PROBE_SEQ && echoed == 0 {
+                            cpu0 = bc::cpu_ns();
+                        }
+                        b[4..8].copy_from_slice(&bc::MSG_PONG.to_le_bytes());
+                        l.send(&b);
+                        if seq != bc::PROBE_SEQ {
+                            echoed += 1;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            bc::partner_line("echo", echoed, if echoed > 0 { bc::cpu_ns() - cpu0 } else { 0 });
             0
         }
         "ping" => {
-            let mut l = link(&s, "ccb/ping", "ccb/pong");
-            if !bc::probe(&mut l, &mut m, bc::MSG_PING, bc::MSG_PONG, start_wait) {
+            let l = link(&s, "ccb/ping", "ccb/pong");
+            if !probe(&l, &mut m, bc::MSG_PING, bc::MSG_PONG, start_wait) {
                 bc::die("zenoh ping: no answer from an echo");
             }
-            let mut r = bc::ping(&mut l, &o, &mut m);
+            let mut smp = vec![bc::MISSING; total];
+            let period = if o.rate_hz > 0.0 { (1e9 / o.rate_hz) as i64 } else { 0 };
+            let t0 = bc::now_ns() + 1_000_000;
+            let mut received = 0u64;
+            let cpu0 = bc::cpu_ns();
+            for i in 0..total {
+                if period > 0 {
+                    bc::sleep_until_ns(t0 + i as i64 * period);
+                }
+                let ts = bc::now_ns();
+                bc::hdr_write(&mut m, bc::MSG_PING, i as u64, ts);
+                l.send(&m);
+                while let Some(b) = l.recv(ts + o.timeout_ns) {
+                    let tr = bc::now_ns();
+                    if let Some((bc::MSG_PONG, seq, t)) = bc::hdr_read(&b) {
+                        if (seq as usize) < total && smp[seq as usize] == bc::MISSING {
+                            smp[seq as usize] = tr - t;
+                            received += 1;
+                            if seq as usize == i {
+                                break;
+                            }
+                        }
+                    }
+                }
+            }
+            let cpu = bc::cpu_ns() - cpu0;
             fin(&l, &mut m, total as u64);
-            bc::finish(&o, &mut r.samples, "zenoh_udp", if o.half { "rtt_half" } else { "rtt" }, &rt,
-                       &format!(",\"program\":\"zenoh-pingpong\",\"zenoh\":\"1.10.2\",\"foreign\":{},\"cpu_ns\":{},\
-                                 \"values\":{}", r.foreign, r.cpu_ns, 2 * r.received));
-            if r.received > 0 { 0 } else { bc::EXIT_FAIL }
+            bc::finish(&o, &mut smp, "zenoh_udp", if o.half { "rtt_half" } else { "rtt" }, &rt,
+                       &format!(",\"program\":\"zenoh-pingpong\",\"zenoh\":\"1.10.2\",\"cpu_ns\":{},\"values\":{}",
+                                cpu, 2 * received));
+            if received > 0 { 0 } else { bc::EXIT_FAIL }
         }
         "source" => {
-            let mut l = link(&s, "ccb/data", "ccb/ack");
-            if !bc::probe(&mut l, &mut m, bc::MSG_DATA, bc::MSG_PONG, start_wait) {
+            let l = link(&s, "ccb/data", "ccb/ack");
+            if !probe(&l, &mut m, bc::MSG_DATA, bc::MSG_PONG, start_wait) {
                 bc::die("zenoh source: no sink answered");
             }
             let period = if o.rate_hz > 0.0 { (1e9 / o.rate_hz) as i64 } else { 0 };
@@ -111,17 +150,17 @@ fn main() {
             0
         }
         "sink" => {
-            let mut l = link(&s, "ccb/ack", "ccb/data");
+            let l = link(&s, "ccb/ack", "ccb/data");
             let mut smp = vec![bc::MISSING; total];
             let (mut received, mut first, mut last, mut cpu0) = (0u64, 0i64, 0i64, 0i64);
-            let mut b = Vec::with_capacity(m.len());
-            while l.recv(&mut b, bc::now_ns() + idle, true) {
+            while let Some(b) = l.recv(bc::now_ns() + idle) {
                 let tr = bc::now_ns();
                 match bc::hdr_read(&b) {
                     Some((bc::MSG_FIN, _, _)) => break,
                     Some((bc::MSG_DATA, bc::PROBE_SEQ, _)) => {
-                        b[4..8].copy_from_slice(&bc::MSG_PONG.to_le_bytes());
-                        l.send(&b);
+                        let mut a = b.clone();
+                        a[4..8].copy_from_slice(&bc::MSG_PONG.to_le_bytes());
+                        l.send(&a);
                     }
                     Some((bc::MSG_DATA, seq, t)) if (seq as usize) < total && smp[seq as usize] == bc::MISSING => {
                         if received == 0 {
@@ -148,8 +187,26 @@ fn main() {
     std::process::exit(code);
 }
 
-/// Three FINs: UDP may lose one.
-fn fin(l: &PubSub, m: &mut [u8], n: u64) {
+/// Send probes (seq = PROBE_SEQ) every 20 ms until one comes back as `answer`.
+fn probe(l: &Link, m: &mut [u8], kind: u32, answer: u32, wait_ns: i64) -> bool {
+    let give_up = bc::now_ns() + wait_ns;
+    while bc::now_ns() < give_up {
+        bc::hdr_write(m, kind, bc::PROBE_SEQ, bc::now_ns());
+        l.send(m);
+        let until = bc::now_ns() + 20_000_000;
+        while let Some(b) = l.recv(until) {
+            if let Some((k, bc::PROBE_SEQ, _)) = bc::hdr_read(&b) {
+                if k == answer {
+                    while l.recv(bc::now_ns() + 30_000_000).is_some() {} // late answers
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
+fn fin(l: &Link, m: &mut [u8], n: u64) {
     for _ in 0..3 {
         bc::hdr_write(m, bc::MSG_FIN, n, bc::now_ns());
         l.send(m);

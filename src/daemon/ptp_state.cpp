@@ -10,6 +10,8 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include "common/platform.h"
+
 namespace ccomm {
 namespace ptp {
 
@@ -109,7 +111,7 @@ bool Monitor::OpenSocket() {
   // An abstract name of our own: ptp4l sends its answer to it, nothing on disk to clean.
   struct sockaddr_un self = {};
   self.sun_family = AF_UNIX;
-  const int n = snprintf(self.sun_path + 1, sizeof self.sun_path - 1, "ccommd-ptp.%d.%p", getpid(),
+  const int n = snprintf(self.sun_path + 1, sizeof self.sun_path - 1, "ccommd-ptp.%d.%p", static_cast<int>(platform::ProcessId()),
                          static_cast<void*>(this));
   const socklen_t slen = static_cast<socklen_t>(offsetof(struct sockaddr_un, sun_path) + 1 + n);
   if (bind(fd_, reinterpret_cast<const sockaddr*>(&self), slen) != 0) {

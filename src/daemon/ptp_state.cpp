@@ -19,6 +19,7 @@ namespace {
 
 constexpr size_t kHeaderSize = 34;           // PTP common header
 constexpr size_t kManagementSize = 48;       // header + target port (10) + hops (2) + action (2)
+static_assert(kManagementSize == kHeaderSize + 10 + 2 + 2, "management message layout");
 constexpr size_t kTlvHeaderSize = 6;         // type, length, management id
 constexpr uint8_t kMessageManagement = 0x0D;
 constexpr uint8_t kActionGet = 0, kActionResponse = 2;

@@ -27,6 +27,9 @@ from . import ros2_profile
 from .schema import (FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
                      WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
 
+HOLD_MIN_NS = 20_000_000  #: messages held behind the capture's watermark, at least
+HOLD_MAX_NS = 2_000_000_000  #: and at most (memory: 2 s of every signal)
+
 COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                "zstd": CompressionType.ZSTD}
 
@@ -87,6 +90,15 @@ class RecordingWriter:
         # messages not yet written: (log time, arrival order, channel, data, publish time, seq)
         self.held: List[Tuple[int, int, int, bytes, int, int]] = []
         self.order = 0
+        # ccommd stamps a received value with the time its frame arrived, which is before
+        # it stores it (longer when the frame waited in its socket: peer_clock.h). So a
+        # value can surface after a watermark later than its stamp; the writer keeps
+        # `hold_ns` behind the watermark and widens it to twice the worst such lateness.
+        self.hold_ns = HOLD_MIN_NS
+        self.last_written = 0  #: log time of the newest message written (never goes back)
+        self.late = 0  #: messages that came after later ones were written: logged at that later time
+        self.late_max_ns = 0  #: the most such a message came late
+        self.watermark = 0  #: newest watermark from the capture
 
     # ---- files ---------------------------------------------------------------------
     def _open(self) -> None:
@@ -156,8 +168,9 @@ class RecordingWriter:
         held, started = self.held, self.o.started_ns
         while pos + head <= end:
             sid, status, flags, seq, recv, src, lost = unpack_from(buf, pos)
-            if sid == WATERMARK_ID:  # every value received up to recv has been captured
-                self._write_held(recv + offset)
+            if sid == WATERMARK_ID:  # every value stored by ccommd up to recv has been captured
+                self.watermark = recv + offset
+                self._write_held(self.watermark - self.hold_ns)
                 pos += head
                 continue
             size = vbytes[sid]
@@ -176,6 +189,9 @@ class RecordingWriter:
             data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap)
             # an initial value (received before the start) is logged at the start
             log_time = started if flags & FLAG_INITIAL else recv + offset
+            if not flags & FLAG_INITIAL and log_time < self.watermark - self.hold_ns // 2:
+                # stored by ccommd well after its stamp: hold longer from now on
+                self.hold_ns = min(HOLD_MAX_NS, max(self.hold_ns, 2 * (self.watermark - log_time)))
             heapq.heappush(held, (log_time, self.order, channel[sid], data, src + offset, seq & 0xFFFFFFFF))
             self.order += 1
             pos += head + size
@@ -190,6 +206,13 @@ class RecordingWriter:
         held, add_message = self.held, self.mcap.add_message
         while held and held[0][0] <= upto:
             log_time, _, channel, data, publish_time, sequence = heapq.heappop(held)
+            if log_time < self.last_written:
+                # Came later than the hold allowed: logged at the newest time written, so
+                # the file stays in log-time order (its receive time is in the message).
+                self.late += 1
+                self.late_max_ns = max(self.late_max_ns, self.last_written - log_time)
+                log_time = self.last_written
+            self.last_written = log_time
             add_message(channel, log_time, data, publish_time, sequence)
 
     def flush(self) -> None:
@@ -208,6 +231,8 @@ class RecordingWriter:
             "values": self.values, "bytes": self.total_bytes(),
             "values_per_s": round(self.values / seconds, 1) if seconds > 0 else 0.0,
             "recorder_missed": self.lost_total(), "ccomm_lost": self.ccomm_lost_total(),
+            "logged_late": self.late, "logged_late_max_ms": round(self.late_max_ns / 1e6, 3),
+            "hold_ms": round(self.hold_ns / 1e6, 3),
             "signals": {self.by_id[i].name: {"values": s.values, "first_seq": s.first_seq,
                                              "last_seq": s.last_seq, "missed": s.gaps,
                                              "lost": (s.last_lost - s.first_lost) if s.values else 0}
@@ -270,6 +295,10 @@ def run_writer(fd: int, o: WriterOptions) -> int:
         print(f"record: {', '.join(s['files'])}: {s['values']} values of {len(o.signals)} signals in "
               f"{elapsed:.1f} s ({s['values_per_s']:.0f}/s), {s['bytes'] / 1e6:.2f} MB, missed by the "
               f"recorder {s['recorder_missed']}, lost in ccomm {s['ccomm_lost']}", file=sys.stderr)
+        if s["logged_late"]:
+            print(f"record: {s['logged_late']} values stored by ccommd more than the reorder hold after "
+                  f"their receive time (at most {s['logged_late_max_ms']} ms): logged at the newest log time "
+                  f"then (their receive_time_ns is exact); the hold grew to {s['hold_ms']} ms", file=sys.stderr)
     if o.stats_json:
         with open(o.stats_json, "w") as f:
             json.dump(s, f, indent=1)

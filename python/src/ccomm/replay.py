@@ -13,7 +13,7 @@ import os
 import signal
 import sys
 import time
-from typing import TYPE_CHECKING, Dict, List, Optional, Sequence, Tuple
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple
 
 from .mcap_io import require_mcap
 from . import _native
@@ -113,9 +113,9 @@ def _percentile(sorted_vals: List[int], q: float) -> int:
 
 
 def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, loop: bool,
-           stop: List[int], quiet: bool) -> Tuple[int, List[int]]:
+           stop: List[int], quiet: bool) -> Tuple[int, List[int], Dict[str, Any]]:
     """Writes the timeline ((source time, seq, signal id, value)); returns (values written,
-    lateness of each write in ns)."""
+    lateness of each write in ns, what made it late: waits for ccommd, full-ring retries)."""
     # The raw calls, bound once; pointers passed as plain addresses (see ccomm._native).
     L, handle, now = _native.lib(), c.handle, time.monotonic_ns
     write = L.ccomm_write
@@ -138,12 +138,17 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
 
     def flush(hd: int) -> None:
         if probe[0] >= 0:
-            deadline = now() + 10_000_000
+            began = now()
+            deadline = began + 10_000_000
             while tx_of(probe[0]) <= probe[1]:
                 if now() >= deadline:
                     no_tx.add(probe[0])
                     break
                 time.sleep(0.00005)
+            waited = now() - began
+            if waited >= 1_000_000:  # how much of the lateness is ccommd's (the report says)
+                waits[0] += 1
+                waits[1] += waited
             probe[0] = -1
         if last_sid[0] >= 0 and last_sid[0] not in no_tx:
             probe[0], probe[1] = last_sid[0], tx_of(last_sid[0])
@@ -151,6 +156,8 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
         raw_flush(hd)
 
     last_sid = [-1]  # a signal written since the last flush
+    retries = [0]  # writes retried after 1 ms because an event ring was full
+    waits = [0, 0]  # flushes that waited 1 ms or more for ccommd to take the previous step, their total ns
     t0 = timeline[0][0]
     span = timeline[-1][0] - t0
     late: List[int] = []
@@ -184,6 +191,8 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
                 time.sleep(0.001)
                 tries += 1
                 r = write(handle, sid, data, len(data))
+            if tries:
+                retries[0] += tries
             if r < 0:
                 raise error(r, f"writing signal {sid} failed")
             late.append(now() - target)
@@ -196,7 +205,8 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
         if not loop:
             break
         start += int(span / rate) + int((span / max(len(timeline) - 1, 1)) / rate)
-    return written, late
+    return written, late, {"waits_over_1ms": waits[0], "waited_ms": round(waits[1] / 1e6, 3),
+                           "full_retries": retries[0]}
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -247,7 +257,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     gc.freeze()
     gc.disable()
     try:
-        written, late = replay(c, timeline, a.rate, a.loop, stop, a.quiet)
+        written, late, why_late = replay(c, timeline, a.rate, a.loop, stop, a.quiet)
     except CcommError as e:
         print(f"\nreplay: {e}", file=sys.stderr)
         return 1
@@ -256,11 +266,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         c.close()
     late.sort()
     stats = {"values": written, "signals": len(chosen), "late_p50_ns": _percentile(late, 0.5),
-             "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0}
+             "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0, **why_late}
     if not a.quiet:
         print(f"\rreplay: wrote {written} values; timing error p50 {stats['late_p50_ns'] / 1e3:.0f} us, "
-              f"p99 {stats['late_p99_ns'] / 1e3:.0f} us, max {stats['late_max_ns'] / 1e3:.0f} us",
-              file=sys.stderr)
+              f"p99 {stats['late_p99_ns'] / 1e3:.0f} us, max {stats['late_max_ns'] / 1e3:.0f} us; waited for "
+              f"ccommd to take a step {why_late['waits_over_1ms']} times 1 ms or more ({why_late['waited_ms']} ms "
+              f"in all), {why_late['full_retries']} retries on a full event ring", file=sys.stderr)
     if a.stats_json:
         with open(a.stats_json, "w") as f:
             json.dump(stats, f, indent=1)

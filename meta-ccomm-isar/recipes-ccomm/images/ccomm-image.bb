@@ -60,3 +60,11 @@ ccomm_initramfs_modules() {
         printf '%s\n' ${CCOMM_INITRAMFS_MODULES} >>'${ROOTFSDIR}/etc/initramfs-tools/modules'
 EOSUDO
 }
+
+# Debian's linuxptp enables timemaster.service (ptp4l and an NTP daemon on one clock). On a
+# ccomm board PTP comes from signals.xml's <clock> through ccomm-ptp4l.service (enabled by
+# hand, docs/config.md); two stacks steering one clock fight, so timemaster stays off.
+ROOTFS_POSTPROCESS_COMMAND += "ccomm_timemaster_off"
+ccomm_timemaster_off() {
+    sudo rm -f '${ROOTFSDIR}/etc/systemd/system/multi-user.target.wants/timemaster.service'
+}

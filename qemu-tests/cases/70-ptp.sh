@@ -1,0 +1,70 @@
+#!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
+# qemu-tests: one clock across the boards, the way a user sets it up: a <clock> section
+# qemu-tests: in signals.xml (control grandmaster, software timestamping), the shipped
+# qemu-tests: ccomm-ptp4l.service on both boards (ptp4l configured by ccommd --clock-config,
+# qemu-tests: IEEE 802.3 over the bridge). Checks that ccommd reports the clock state
+# qemu-tests: ptp4l has (planner: synced) and reports the sync error the slave measured
+# qemu-tests: once locked (ptp4l's "master offset": rms and largest). The harness puts
+# qemu-tests: the original signals.xml back afterwards.
+# qemu-tests: timeout=300
+. "$(dirname "$0")/../lib/common.sh"
+need_ccomm
+
+SYNC_SECONDS=${QT_PTP_SECONDS:-20}   # samples taken once the slave is synced
+LOCK_TIMEOUT=${QT_PTP_LOCK_TIMEOUT:-120}
+CFG=/etc/ccomm/signals.xml
+UNIT=/usr/share/ccomm/systemd/ccomm-ptp4l.service
+OUT=$QT_WORK/ptp.json
+
+for b in control planner; do
+	check "$b: ptp4l (linuxptp) and the ccomm-ptp4l unit installed" vm "$b" "command -v ptp4l >/dev/null && test -f $UNIT"
+done
+vm control "test -f $UNIT" || finish
+note "planner eth0: $(vm planner 'ethtool -T eth0 2>/dev/null | grep -i software | tr -s "\t\n " " "')"
+
+for b in control planner; do
+	vm "$b" "sed -i 's|</ccomm>|  <clock grandmaster=\"control\" timestamping=\"software\" sync_interval_log=\"-3\"/>\n</ccomm>|' $CFG"
+	check "$b: signals.xml with <clock> passes ccommd --check" vm "$b" "ccommd --config $CFG --check >/dev/null"
+	check "$b: ccommd --clock-config gives ptp4l its role" \
+		vm "$b" "ccommd --config $CFG --clock-config | grep -q '^priority1'"
+	# --no-block: on an emulated board a restart can take longer than one agent command
+	vm "$b" "cp $UNIT /etc/systemd/system/ && systemctl daemon-reload && systemctl --no-block restart ccomm-ptp4l ccommd"
+done
+active() { vm "$1" 'systemctl is-active -q ccomm-ptp4l && systemctl is-active -q ccommd'; }
+for b in control planner; do
+	if wait_until 90 active "$b"; then
+		check "$b: ccomm-ptp4l and ccommd running" true
+	else
+		fail "$b: ccomm-ptp4l and ccommd not both running after 90 s"
+		vm "$b" 'systemctl list-jobs --no-pager; systemctl status --no-pager ccomm-ptp4l ccommd | tail -n 20'
+	fi
+done
+note "control: ptp4l's socket: $(vm control 'ls -l /var/run/ptp4l')"
+
+clock_line() { vm "$1" 'ccomm stats 2>/dev/null | grep "^clock:"'; }
+synced() { clock_line planner | grep -q '^clock: synced'; }
+if wait_until "$LOCK_TIMEOUT" synced; then
+	check "planner's ccommd: clock synced to control's (ptp4l over the bridge)" true
+	note "control: $(clock_line control)"
+	note "planner: $(clock_line planner)"
+	sleep "$SYNC_SECONDS"
+	# ptp4l's once-a-second summaries of its offsets from the master ("rms N max N freq
+	# ... delay N", ns; with Sync faster than 1/s it prints these instead of each offset),
+	# over the last SYNC_SECONDS, from its journal
+	stats=$(vm planner "journalctl -u ccomm-ptp4l -o cat --no-pager | grep ' rms .* max .* freq' | tail -n $SYNC_SECONDS" |
+		awk '{ for (i = 1; i < NF; i++) { if ($i == "rms") { r = $(i + 1); n++; s += r * r } if ($i == "max" && $(i + 1) > m) m = $(i + 1)
+		                                   if ($i == "delay") { d += $(i + 1); nd++ } } }
+		     END { if (n) printf "{\"seconds\":%d,\"offset_rms_ns\":%.0f,\"offset_max_ns\":%d,\"path_delay_ns\":%.0f}\n", n, sqrt(s / n), m, nd ? d / nd : 0 }')
+	echo "$stats" >"$OUT"
+	note "sync error over the last ${SYNC_SECONDS} s (ptp4l on planner; software timestamps on emulated boards): $stats"
+	check "sync error measured from ptp4l's offsets" test -n "$stats"
+else
+	fail "planner's ccommd did not report a synced clock within ${LOCK_TIMEOUT} s ($(clock_line planner))"
+	vm planner 'journalctl -u ccomm-ptp4l -o cat --no-pager | tail -n 20'
+fi
+
+for b in control planner; do
+	vm "$b" "systemctl stop ccomm-ptp4l; rm -f /etc/systemd/system/ccomm-ptp4l.service; systemctl daemon-reload"
+done
+finish

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/value_type.h"
+#include "config/outline.h"
 
 namespace ccomm {
 
@@ -93,19 +94,6 @@ struct NetworkConfig {
   uint8_t multicast_base[4] = {239, 255, 67, 0};  // UDP group of node n: base + n
 };
 
-// <ros2>: what ccomm-ros2 on one node bridges (local policy, not in the hash).
-// Parsed and checked by ros2_section.cpp; docs/integrations/ros2.md.
-struct Ros2Config {
-  std::string node;                   // the node the bridge runs on
-  std::string ros_namespace = "ccomm";
-  uint32_t domain = 0;                // ROS 2 domain id 0..232
-  bool has_domain = false;
-  bool publish_given = false;         // false: every signal the node consumes
-  std::vector<std::string> publish;   // ccomm -> ROS 2
-  std::vector<std::string> subscribe; // ROS 2 -> ccomm (signals the node produces)
-  int line = 0;
-};
-
 // <clock>: linuxptp between the boards (local policy, not in the hash: a wrong domain shows
 // as a clock that never syncs, not as refused frames). Parsed by clock_section.cpp;
 // ccommd --clock-config writes ptp4l's configuration from it (daemon/ptp_config.cpp).
@@ -124,7 +112,8 @@ struct SystemConfig {
   NetworkConfig network;
   std::vector<NodeConfig> nodes;
   std::vector<SignalConfig> signals;
-  std::vector<Ros2Config> ros2;  // at most one per node
+  std::vector<SectionElement> sections;  // extension sections such as <ros2>, checked for
+                                        // structure only: their owners read them (outline.h)
   ClockConfig clock;             // <clock>, at most one
   uint32_t hash = 0;           // FNV-1a over a canonical form of what both ends must agree on
                                // (node names/order, signal name/type/count/kind/producer/

@@ -87,7 +87,7 @@ struct NetworkConfig {
   uint16_t udp_port = 47800;
   uint32_t heartbeat_ms = 100;
   uint32_t peer_timeout_ms = 300;
-  uint32_t summary_ms = 1000;  // node summaries for `ccomm stats --all`: one full round per this
+  uint32_t summary_ms = 1000;  // node summaries (the system view): one full round per this
                                // many ms, at most one frame per 100 ms; 0 = none (local policy)
   std::string auth_key_file;   // empty = no authentication
   Fanout fanout = Fanout::kUnicast;

@@ -14,6 +14,8 @@
   of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp only, and a program
   that owns an extension section of signals.xml (the bridge's <ros2>) the configuration's
   public interface config/outline.h, which itself includes standard headers only;
+- no two source files under src/ share a name (two system_view.cpp once meant two
+  different things), except the platform units and each program's main.cpp;
 - signals.xml has one parser (src/config/): no other code uses an XML parser on it
   (tools read `ccommd --check FILE --json`), and the value types' names are tabled once
   (src/common/value_type.h; ccomm_type_name() gives them out).
@@ -119,6 +121,21 @@ def application_includes(src, errors):
                                   % (rel, inc))
 
 
+def unique_file_names(src, errors):
+    """A file's name says what it is: one name, one file (per-platform units excepted: the
+    same interface in src/common/platform/posix/ and .../windows/)."""
+    seen = {}
+    for name in tracked_code(src):
+        if not name.startswith("src/") or name.startswith("src/common/platform/") or \
+                os.path.basename(name) == "main.cpp":
+            continue
+        seen.setdefault(os.path.basename(name), []).append(name)
+    for base, names in sorted(seen.items()):
+        if len(names) > 1:
+            errors.append("%s: %d files share the name (%s): name each after what it is"
+                          % (base, len(names), ", ".join(names)))
+
+
 def public_interfaces(src, errors):
     """A public interface is public only if it pulls in no internals."""
     for header in PUBLIC_INTERFACES:
@@ -133,6 +150,7 @@ def main():
     errors = []
     application_includes(src, errors)
     public_interfaces(src, errors)
+    unique_file_names(src, errors)
     one_parser_one_table(src, errors)
     # 1. Includes of the bottom modules.
     for module, allowed in BOTTOM.items():
@@ -186,7 +204,7 @@ def main():
         print("layering: " + e)
     if not errors:
         print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
-              "applications use the public API (and config/outline.h); one parser of signals.xml, one table of type names")
+              "applications use the public API (and config/outline.h); one file per name; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 
 

@@ -90,6 +90,7 @@ void Objects(std::string* o, const char* k, size_t n, Members&& members) {
 // The members of one extension element: name, line, attributes (name: value), children.
 void Section(std::string* o, const SectionElement& e) {
   Text(o, "name", e.name);
+
   Num(o, "line", static_cast<unsigned long long>(e.line));
   Object(o, "attributes", [&] {
     for (const SectionAttribute& a : e.attributes) Text(o, a.name.c_str(), a.value);
@@ -144,7 +145,11 @@ std::string ConfigToJson(const SystemConfig& cfg) {
     Num(&o, "line", static_cast<unsigned long long>(sig.line));
   });
   // Extension sections as the core keeps them (outline.h): their owners give them meaning.
-  Objects(&o, "sections", cfg.sections.size(), [&](size_t i) { Section(&o, cfg.sections[i]); });
+  Objects(&o, "sections", cfg.sections.size(), [&](size_t i) {
+    for (const ExtensionSection& s : kExtensionSections)
+      if (cfg.sections[i].name == s.name) Text(&o, "owner", s.owner);  // who checks its content
+    Section(&o, cfg.sections[i]);
+  });
   Close(&o, '}');
   o += '\n';
   return o;

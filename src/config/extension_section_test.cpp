@@ -61,7 +61,7 @@ TEST(ExtensionSection, NotHashedAndInTheJson) {
   ASSERT_TRUE(ParseConfig(Doc(""), "t.xml", &without, &err)) << err;
   EXPECT_EQ(with.hash, without.hash);  // local policy
   const std::string json = ConfigToJson(with);
-  EXPECT_NE(json.find("\"sections\":[{\"name\":\"ros2\",\"line\":5,\"attributes\":{\"node\":\"planner\","
+  EXPECT_NE(json.find("\"sections\":[{\"owner\":\"ccomm-ros2\",\"name\":\"ros2\",\"line\":5,\"attributes\":{\"node\":\"planner\","
                       "\"domain\":\"7\"},\"children\":[]}]"),
             std::string::npos)
       << json;

@@ -18,13 +18,14 @@
 
 namespace ccomm {
 
-/// Extension sections the core accepts as children of <ccomm>, and who reads each.
+/// Extension sections the core accepts as children of <ccomm>, and the program that
+/// reads and checks each (`ccommd --check --json` names it with the section).
 struct ExtensionSection {
   const char* name;
   const char* owner;
 };
 constexpr ExtensionSection kExtensionSections[] = {
-    {"ros2", "ccomm-ros2 (docs/integrations/ros2.md)"},
+    {"ros2", "ccomm-ros2"},  // docs/integrations/ros2.md
 };
 
 struct SectionAttribute {

@@ -28,7 +28,7 @@ target_link_libraries(ccomm_segment_builder PUBLIC ccomm_store ccomm_config)
 
 set(_cl ${CMAKE_CURRENT_LIST_DIR}/client)
 add_library(ccomm SHARED ${_cl}/client.cpp ${_cl}/client_open.cpp ${_cl}/client_info.cpp ${_cl}/history.cpp
-            ${_cl}/system_view.cpp ${_cl}/doorbell_futex.cpp)
+            ${_cl}/system_view_reader.cpp ${_cl}/doorbell_futex.cpp)
 ccomm_core_target(ccomm)
 target_compile_definitions(ccomm PRIVATE CCOMM_BUILDING_DLL)
 target_link_libraries(ccomm PRIVATE ccomm_store)

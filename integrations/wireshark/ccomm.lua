@@ -159,7 +159,7 @@ local function load_config(path)
   fh:close()
   local hash = text:match('"hash":"(%x+)"')
   local nodes = text:match('"nodes":%[(.-)%]')
-  local signals = text:match('"signals":%[(.*)%],"ros2"')
+  local signals = text:match('"signals":%[(.*)%],"sections"')
   if not (text:match('^{"format":1,') and hash and nodes and signals) then
     config.error = path .. " is not the output of ccommd --check signals.xml --json"
     return

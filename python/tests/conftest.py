@@ -20,7 +20,8 @@ def find_build() -> Optional[Path]:
     if os.environ.get("CCOMM_BUILD_DIR"):
         cands = [Path(os.environ["CCOMM_BUILD_DIR"])]
     else:
-        cands = sorted(REPO.glob("build*"), key=lambda p: p.stat().st_mtime, reverse=True)
+        # Build trees are build/NAME/ (docs/testing.md); the newest one that has both.
+        cands = sorted(REPO.glob("build/*"), key=lambda p: p.stat().st_mtime, reverse=True)
     for b in cands:
         if (b / "bin" / "ccommd").is_file() and (b / "lib" / "libccomm.so").exists():
             return b.resolve()

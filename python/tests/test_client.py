@@ -202,16 +202,17 @@ def test_library_lookup(tmp_path: Path) -> None:
 
     with pytest.raises(ccomm.LibraryNotFoundError):
         _native.find_library({"CCOMM_LIBRARY": str(tmp_path / "missing.so")}, [])
-    # A build directory inside a source tree is found from a path inside the tree.
+    # A build tree inside a source tree (build/NAME/, as scripts/build makes it) is found
+    # from a path inside the tree.
     (tmp_path / "src" / "include" / "ccomm").mkdir(parents=True)
     (tmp_path / "src" / "include" / "ccomm" / "ccomm.h").write_text("")
-    (tmp_path / "build-x" / "lib").mkdir(parents=True)
-    lib = tmp_path / "build-x" / "lib" / "libccomm.so.0"
+    (tmp_path / "build" / "release" / "lib").mkdir(parents=True)
+    lib = tmp_path / "build" / "release" / "lib" / "libccomm.so.0"
     lib.write_text("")
     deep = tmp_path / "python" / "src"
     deep.mkdir(parents=True)
     assert _native.find_library({}, [deep]) == str(lib)
-    assert _native.find_library({"CCOMM_BUILD_DIR": str(tmp_path / "build-x")}, []) == str(lib)
+    assert _native.find_library({"CCOMM_BUILD_DIR": str(tmp_path / "build" / "release")}, []) == str(lib)
 
 
 def test_system_view(client: Client) -> None:

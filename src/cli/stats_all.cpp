@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// `ccomm stats --all`: every node of the system, from the node summaries this board's
-// ccommd gathered (the libccomm view API), as a table or one JSON object per snapshot.
+// `ccomm stats --all`: the system view (every node as this board's ccommd heard it from
+// the node summaries; libccomm's ccomm_view_*), as a table or one JSON object per snapshot.
 #include <inttypes.h>
 #include <stdio.h>
 #include <string.h>

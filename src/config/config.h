@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/value_type.h"
+#include "config/outline.h"
 
 namespace ccomm {
 
@@ -86,24 +87,11 @@ struct NetworkConfig {
   uint16_t udp_port = 47800;
   uint32_t heartbeat_ms = 100;
   uint32_t peer_timeout_ms = 300;
-  uint32_t summary_ms = 1000;  // node summaries for `ccomm stats --all`: one full round per this
+  uint32_t summary_ms = 1000;  // node summaries (the system view): one full round per this
                                // many ms, at most one frame per 100 ms; 0 = none (local policy)
   std::string auth_key_file;   // empty = no authentication
   Fanout fanout = Fanout::kUnicast;
   uint8_t multicast_base[4] = {239, 255, 67, 0};  // UDP group of node n: base + n
-};
-
-// <ros2>: what ccomm-ros2 on one node bridges (local policy, not in the hash).
-// Parsed and checked by ros2_section.cpp; docs/integrations/ros2.md.
-struct Ros2Config {
-  std::string node;                   // the node the bridge runs on
-  std::string ros_namespace = "ccomm";
-  uint32_t domain = 0;                // ROS 2 domain id 0..232
-  bool has_domain = false;
-  bool publish_given = false;         // false: every signal the node consumes
-  std::vector<std::string> publish;   // ccomm -> ROS 2
-  std::vector<std::string> subscribe; // ROS 2 -> ccomm (signals the node produces)
-  int line = 0;
 };
 
 // <clock>: linuxptp between the boards (local policy, not in the hash: a wrong domain shows
@@ -124,7 +112,8 @@ struct SystemConfig {
   NetworkConfig network;
   std::vector<NodeConfig> nodes;
   std::vector<SignalConfig> signals;
-  std::vector<Ros2Config> ros2;  // at most one per node
+  std::vector<SectionElement> sections;  // extension sections such as <ros2>, checked for
+                                        // structure only: their owners read them (outline.h)
   ClockConfig clock;             // <clock>, at most one
   uint32_t hash = 0;           // FNV-1a over a canonical form of what both ends must agree on
                                // (node names/order, signal name/type/count/kind/producer/

@@ -87,6 +87,17 @@ void Objects(std::string* o, const char* k, size_t n, Members&& members) {
   *o += ',';
 }
 
+// The members of one extension element: name, line, attributes (name: value), children.
+void Section(std::string* o, const SectionElement& e) {
+  Text(o, "name", e.name);
+
+  Num(o, "line", static_cast<unsigned long long>(e.line));
+  Object(o, "attributes", [&] {
+    for (const SectionAttribute& a : e.attributes) Text(o, a.name.c_str(), a.value);
+  });
+  Objects(o, "children", e.children.size(), [&](size_t i) { Section(o, e.children[i]); });
+}
+
 }  // namespace
 
 std::string ConfigToJson(const SystemConfig& cfg) {
@@ -133,13 +144,11 @@ std::string ConfigToJson(const SystemConfig& cfg) {
     Bool(&o, "has_safe_value", sig.has_safe_value);
     Num(&o, "line", static_cast<unsigned long long>(sig.line));
   });
-  Objects(&o, "ros2", cfg.ros2.size(), [&](size_t i) {
-    const Ros2Config& r = cfg.ros2[i];
-    Text(&o, "node", r.node);
-    Text(&o, "namespace", r.ros_namespace);
-    if (r.has_domain) Num(&o, "domain", r.domain);
-    if (r.publish_given) Names(&o, "publish", r.publish);
-    Names(&o, "subscribe", r.subscribe);
+  // Extension sections as the core keeps them (outline.h): their owners give them meaning.
+  Objects(&o, "sections", cfg.sections.size(), [&](size_t i) {
+    for (const ExtensionSection& s : kExtensionSections)
+      if (cfg.sections[i].name == s.name) Text(&o, "owner", s.owner);  // who checks its content
+    Section(&o, cfg.sections[i]);
   });
   Close(&o, '}');
   o += '\n';

@@ -11,8 +11,9 @@
 namespace ccomm {
 
 /// One JSON object: {"format": 1, "path", "hash", "network": {...}, "nodes": [...],
-/// "signals": [...], "ros2": [...]}; every cross reference resolved (producer and
-/// consumers by node name), every default applied. docs/config.md, "As JSON".
+/// "signals": [...], "sections": [...]}; every cross reference resolved (producer and
+/// consumers by node name), every default applied; extension sections (<ros2>) as
+/// element trees (name, line, attributes, children). docs/config.md, "As JSON".
 std::string ConfigToJson(const SystemConfig& cfg);
 
 }  // namespace ccomm

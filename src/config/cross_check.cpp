@@ -120,7 +120,6 @@ void Parser::CrossCheck(SystemConfig* cfg) {
       check_transport(s, producer, m, mn.line);
     }
   }
-  CrossCheckRos2(cfg);
   CrossCheckClock(cfg);
 }
 

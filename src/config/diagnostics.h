@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "config/outline.h"
+
 namespace ccomm {
 namespace config_detail {
 
@@ -73,10 +75,7 @@ class Diagnostics {
       overflow_ = true;
     }
   }
-  std::string Prefix(int line) const {
-    if (line <= 0) return path_ + ": error: ";
-    return path_ + ":" + std::to_string(line) + ": error: ";
-  }
+  std::string Prefix(int line) const { return ConfigError(path_, line, ""); }
 
   std::string path_;
   const char* begin_;

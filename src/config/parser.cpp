@@ -160,7 +160,8 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
   int nodes_seen = 0, signals_seen = 0;
   int node_elements = 0;
   for (const Node* c = root->first_node("node"); c; c = c->next_sibling("node")) ++node_elements;
-  const std::vector<std::string> kChildren = {"network", "node", "signal", "ros2", "clock"};
+  std::vector<std::string> children = {"network", "node", "signal", "clock"};
+  for (const ExtensionSection& s : kExtensionSections) children.push_back(s.name);
   for (const Node* c = root->first_node(); c; c = c->next_sibling()) {
     if (c->type() != rapidxml::node_element) continue;
     std::string_view name = NameOf(c);
@@ -188,10 +189,10 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
         cfg->signals.push_back(std::move(sig));
         refs_.push_back(std::move(refs));
       }
-    } else if (name == "ros2") {
-      Ros2Config r;
-      Ros2Element(c, &r);
-      cfg->ros2.push_back(std::move(r));
+    } else if (IsExtensionSection(name)) {
+      SectionElement section;
+      ExtensionElement(c, &section);
+      cfg->sections.push_back(std::move(section));
     } else if (name == "clock") {
       if (cfg->clock.present) {
         Err(line, "second <clock> (first at line " + std::to_string(cfg->clock.line) + ")");
@@ -199,8 +200,11 @@ void Parser::Root(const Node* root, SystemConfig* cfg) {
       }
       ClockElement(c, &cfg->clock);
     } else {
-      std::string hint = Suggest(name, kChildren);
-      if (hint.empty()) hint = " (expected network, node, signal, ros2 or clock)";
+      std::string hint = Suggest(name, children);
+      if (hint.empty()) {
+        std::vector<std::string> all_but_last(children.begin(), children.end() - 1);
+        hint = " (expected " + Join(all_but_last, ", ") + " or " + children.back() + ")";
+      }
       Err(line, "unknown element <" + std::string(name) + "> in <ccomm>" + hint);
     }
   }

@@ -113,6 +113,8 @@ class Element {
 void CheckNoText(const Node* parent, Diagnostics* diag);
 /// Reports child elements of an element that has attributes only (and no text).
 void CheckAttributesOnly(const Node* parent, Diagnostics* diag);
+/// Whether <name> in <ccomm> is an extension section (outline.h: kExtensionSections).
+bool IsExtensionSection(std::string_view name);
 /// Reports "--" inside comments (xmllint and editors reject them).
 void CheckComments(const Node* parent, Diagnostics* diag);
 
@@ -140,8 +142,7 @@ class Parser {
   void SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs);
   void SafeValue(const AttrValue& a, SignalConfig* sig);
   void CrossCheck(SystemConfig* cfg);
-  void Ros2Element(const Node* n, Ros2Config* out);     // ros2_section.cpp
-  void CrossCheckRos2(SystemConfig* cfg);               // ros2_section.cpp
+  void ExtensionElement(const Node* n, SectionElement* out);  // extension_section.cpp
   void ClockElement(const Node* n, ClockConfig* out);   // clock_section.cpp
   void CrossCheckClock(SystemConfig* cfg);              // clock_section.cpp
 

@@ -2,10 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """docs/signals.xsd accepts every file ccommd accepts.
 
-  schema_accepts_test.py CCOMMD XSD FILE_OR_DIR...
+  schema_accepts_test.py CCOMMD[,SECTION_CHECKER...] XSD FILE_OR_DIR...
 
 Each XML file given (directories: their *.xml and every file of fuzz corpora) that
-`ccommd --check` accepts must also validate under xmllint, and variants of each with its
+`ccommd --check` accepts, and every checker of an extension section (`CHECKER FILE`, e.g.
+the bridge's <ros2> checker: ccommd checks only the structure of such a section) with
+it, must also validate under xmllint, and variants of each with its
 empty elements written with an end tag and whitespace between (<x ...>\\n  </x>) too.
 The parser stays the authority; the schema must never refuse what it accepts.
 Exit 0 if all hold, 1 with one line per file the schema refuses.
@@ -26,8 +28,10 @@ def files(paths):
             yield p
 
 
-def accepted(ccommd, path):
-    return subprocess.run([ccommd, "--check", path], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
+def accepted(checkers, path):
+    ccommd, sections = checkers[0], checkers[1:]
+    run = lambda argv: subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
+    return run([ccommd, "--check", path]) and all(run([c, path]) for c in sections)
 
 
 def validates(xsd, path):
@@ -37,7 +41,7 @@ def validates(xsd, path):
 
 
 def main():
-    ccommd, xsd, paths = sys.argv[1], sys.argv[2], sys.argv[3:]
+    ccommd, xsd, paths = sys.argv[1].split(","), sys.argv[2], sys.argv[3:]
     bad, checked = [], 0
     with tempfile.TemporaryDirectory() as tmp:
         for path in files(paths):
@@ -54,7 +58,7 @@ def main():
                 checked += 1
                 ok, why = validates(xsd, candidate)
                 if not ok:
-                    bad.append("%s: ccommd accepts it, the schema refuses it: %s" % (name, " / ".join(why)))
+                    bad.append("%s: ccommd (and the section checkers) accept it, the schema refuses it: %s" % (name, " / ".join(why)))
     for b in bad:
         print("schema: " + b)
     print("schema: %d accepted files checked, %d refused by the schema" % (checked, len(bad)))

@@ -220,7 +220,7 @@ void Daemon::Supervise(uint64_t now) {
     }
   }
   SuperviseClock(now);
-  view_.Tick(now);  // this node's summary, rate-limited (system_view.h)
+  view_.Tick(now);  // this node's summary, rate-limited (system_view_writer.h)
   for (uint32_t id : consumed_) {
     const SignalConfig& s = cfg_->signals[id];
     if (!s.stale_after_ms) continue;

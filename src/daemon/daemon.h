@@ -15,7 +15,7 @@
 #include "daemon/foreign_frames.h"
 #include "daemon/peer_clock.h"
 #include "daemon/ptp_state.h"
-#include "daemon/system_view.h"
+#include "daemon/system_view_writer.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
@@ -181,7 +181,7 @@ class Daemon {
   bool adopted_ = false;
   Transport transport_;
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
-  SystemView view_;                        // node summaries: ccomm stats --all (system_view.h)
+  SystemViewWriter view_;                  // the system view: node summaries out and in (system_view_writer.h)
   ForeignFrameWatch foreign_;              // mismatched boards' frames (foreign_frames.h)
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};

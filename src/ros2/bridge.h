@@ -31,6 +31,7 @@ struct Options {
   int priority = 0;                  // SCHED_FIFO priority of the ccomm -> ROS 2 thread (0: none)
   double stats_interval_s = 0;       // 0: stats only on SIGUSR1 and at exit
   bool list_only = false;
+  bool check_only = false;           // --check: validate the configuration's <ros2> sections, exit
   int verbose = 0;
 };
 
@@ -41,9 +42,6 @@ int ParseOptions(int argc, char** argv, Options* o);
 // Takes what the command line left open from the <ros2 node=NODE> section of
 // o->config_path (config_section.cpp). False with the file's errors on stderr.
 bool ApplyConfigSection(Options* o, const std::string& node);
-
-// A signal name usable as one ROS 2 topic name token.
-bool ValidRosTopicToken(const std::string& s);
 
 // The ROS 2 message type of a ccomm signal (see dds_types.cpp).
 struct RosType {

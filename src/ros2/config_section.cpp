@@ -1,25 +1,28 @@
 // SPDX-License-Identifier: Apache-2.0
-// The <ros2> element of signals.xml (parsed and checked by the configuration parser, the
-// same one `ccommd --check` runs): the bridge's settings for one node, under whatever the
-// command line set explicitly.
+// The <ros2> element of signals.xml for the bridge's node: the file read with the parser
+// `ccommd --check` runs (config/outline.h), the <ros2> sections checked here (section.h),
+// their settings applied under whatever the command line set explicitly.
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "bridge.h"
-#include "config/config.h"
+#include "config/outline.h"
+#include "section.h"
 
 namespace ccomm_ros2 {
 
 bool ApplyConfigSection(Options* o, const std::string& node) {
   if (o->config_path.empty()) return true;
-  ccomm::SystemConfig cfg;
+  ccomm::ConfigOutline cfg;
+  std::vector<Ros2Section> sections;
   std::string err;
-  if (!ccomm::LoadConfig(o->config_path, &cfg, &err)) {
-    fprintf(stderr, "%sccomm-ros2: %s is not a valid configuration (see above; ccommd --check %s)\n",
+  if (!ccomm::LoadConfigOutline(o->config_path, &cfg, &err) || !ReadRos2Sections(cfg, &sections, &err)) {
+    fprintf(stderr, "%s\nccomm-ros2: %s is not a valid configuration (see above; ccomm-ros2 --check --config %s)\n",
             err.c_str(), o->config_path.c_str(), o->config_path.c_str());
     return false;
   }
-  for (const ccomm::Ros2Config& r : cfg.ros2) {
+  for (const Ros2Section& r : sections) {
     if (r.node != node) continue;
     if (!o->namespace_given) o->ros_namespace = r.ros_namespace;
     if (!o->domain_given && r.has_domain) o->domain = static_cast<int>(r.domain);

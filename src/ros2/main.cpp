@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "bridge.h"
+#include "section.h"
 
 namespace ccomm_ros2 {
 
@@ -110,7 +111,7 @@ bool AddRoute(Bridge* b, ccomm_client* c, const std::string& name, bool to_ros) 
                     "only a producer's values can come from ROS 2\n", name.c_str(), d.producer, ccomm_node_name(c));
     return false;
   }
-  if (!ValidRosTopicToken(name)) {
+  if (!IsRosToken(name)) {
     fprintf(stderr, "ccomm-ros2: signal '%s' is not a valid ROS 2 topic name token (letters, digits, '_')\n",
             name.c_str());
     return false;
@@ -196,6 +197,13 @@ int main(int argc, char** argv) {
   Bridge b;
   int rc = ParseOptions(argc, argv, &b.opt);
   if (rc >= 0) return rc;
+  if (b.opt.check_only) {
+    if (b.opt.config_path.empty()) {
+      fprintf(stderr, "ccomm-ros2: --check needs --config FILE (no /etc/ccomm/signals.xml)\n");
+      return 2;
+    }
+    return CheckConfig(b.opt.config_path);
+  }
   b.node = b.opt.node;
 
   // Waits for ccommd (a default SIGINT still ends the program here: nothing to undo yet).

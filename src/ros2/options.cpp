@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "bridge.h"
+#include "section.h"
 
 namespace ccomm_ros2 {
 namespace {
@@ -47,6 +48,9 @@ const char kUsage[] =
     "      --stats SECONDS       print the counters as one JSON line every SECONDS\n"
     "                            (always on SIGUSR1 and at exit)\n"
     "  -l, --list                print the topics, types and QoS the bridge would use, and exit\n"
+    "      --check               validate the configuration (--config FILE, as ccommd --check)\n"
+    "                            and its <ros2> sections, print every error as FILE:LINE, and\n"
+    "                            exit: 0 valid, 1 not; needs no ccommd\n"
     "  -v, --verbose             more messages on stderr\n"
     "  -h, --help                this text\n"
     "\n"
@@ -78,28 +82,10 @@ bool ParseDomain(const char* s, const char* what, int* out) {
   return true;
 }
 
-// ROS 2 topic name tokens: letters, digits and '_', not starting with a digit; '/'
-// separates tokens (no empty ones).
-bool ValidRosName(const std::string& s, bool allow_slash) {
-  bool token_start = true;
-  for (char ch : s) {
-    if (ch == '/' && allow_slash) {
-      if (token_start) return false;
-      token_start = true;
-      continue;
-    }
-    bool alpha = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || ch == '_';
-    bool digit = ch >= '0' && ch <= '9';
-    if (!alpha && !(digit && !token_start)) return false;
-    token_start = false;
-  }
-  return !token_start || s.empty();
-}
-
 }  // namespace
 
 int ParseOptions(int argc, char** argv, Options* o) {
-  enum { kStamp = 1000, kStats, kPriority };
+  enum { kStamp = 1000, kStats, kPriority, kCheck };
   static const struct option kLong[] = {
       {"node", required_argument, nullptr, 'n'},   {"namespace", required_argument, nullptr, 's'},
       {"domain", required_argument, nullptr, 'd'}, {"publish", required_argument, nullptr, 'p'},
@@ -107,7 +93,7 @@ int ParseOptions(int argc, char** argv, Options* o) {
       {"stats", required_argument, nullptr, kStats},
       {"priority", required_argument, nullptr, kPriority}, {"list", no_argument, nullptr, 'l'},
       {"verbose", no_argument, nullptr, 'v'},      {"help", no_argument, nullptr, 'h'},
-      {"config", required_argument, nullptr, 'c'},
+      {"config", required_argument, nullptr, 'c'}, {"check", no_argument, nullptr, kCheck},
       {nullptr, 0, nullptr, 0}};
   if (const char* env = getenv("ROS_DOMAIN_ID"); env && *env) {
     if (!ParseDomain(env, "from ROS_DOMAIN_ID", &o->domain)) return 2;
@@ -152,6 +138,7 @@ int ParseOptions(int argc, char** argv, Options* o) {
         break;
       }
       case 'l': o->list_only = true; break;
+      case kCheck: o->check_only = true; break;
       case 'v': ++o->verbose; break;
       case 'h': fputs(kUsage, stdout); return 0;
       default: fputs("Try 'ccomm-ros2 --help'.\n", stderr); return 2;
@@ -165,7 +152,7 @@ int ParseOptions(int argc, char** argv, Options* o) {
   std::string& ns = o->ros_namespace;  // stored without leading/trailing '/'
   while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
   while (!ns.empty() && ns.back() == '/') ns.pop_back();
-  if (!ValidRosName(ns, true)) {
+  if (!IsRosNamespace(ns)) {
     fprintf(stderr, "ccomm-ros2: --namespace '%s' is not a ROS 2 name (letters, digits, '_', "
                     "'/' between tokens, no token starting with a digit)\n", ns.c_str());
     return 2;
@@ -178,7 +165,5 @@ int ParseOptions(int argc, char** argv, Options* o) {
       }
   return -1;
 }
-
-bool ValidRosTopicToken(const std::string& s) { return !s.empty() && ValidRosName(s, false); }
 
 }  // namespace ccomm_ros2

@@ -11,7 +11,7 @@ import time
 import uuid
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-BUILD = os.environ.get("CCOMM_BUILD_DIR", os.path.join(ROOT, "build"))
+BUILD = os.environ.get("CCOMM_BUILD_DIR", os.path.join(ROOT, "build", "release"))  # docs/testing.md
 BIN = os.path.join(BUILD, "bin")
 DEFAULT_CONFIG = os.path.join(ROOT, "dist", "signals.xml")
 

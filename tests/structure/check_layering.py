@@ -11,7 +11,11 @@
   no RapidXML, no configuration parser, no config library symbol, exports nothing but
   the C API (ccomm_*), and needs no library beyond the C/C++ runtime;
 - the applications of the public API (the CLI, tools, the ROS 2 bridge) include nothing
-  of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp only;
+  of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp only, and a program
+  that owns an extension section of signals.xml (the bridge's <ros2>) the configuration's
+  public interface config/outline.h, which itself includes standard headers only;
+- no two source files under src/ share a name (two system_view.cpp once meant two
+  different things), except the platform units and each program's main.cpp;
 - signals.xml has one parser (src/config/): no other code uses an XML parser on it
   (tools read `ccommd --check FILE --json`), and the value types' names are tabled once
   (src/common/value_type.h; ccomm_type_name() gives them out).
@@ -27,10 +31,11 @@ BOTTOM = {"store": {"store", "common"}, "wire": {"wire", "common"}}
 UPPER = ("config", "daemon", "client")
 APPLICATIONS = ("cli", "tools", "ros2")
 INTERNALS = {"config", "daemon", "store", "wire", "client", "common"}
-# (file, include): why it is allowed for now.
-APPLICATION_INCLUDES = {
-    ("src/ros2/config_section.cpp", "config/config.h"):
-        "the <ros2> section is still parsed by the core parser (issue 26: move it into src/ros2)",
+# (file, include): why it is allowed for now (none: keep it that way).
+APPLICATION_INCLUDES = {}
+# Public interfaces of internal modules, and who may include them.
+PUBLIC_INTERFACES = {
+    "config/outline.h": "the configuration as the owner of an extension section reads it (src/ros2: <ros2>)",
 }
 CODE = (".py", ".lua", ".c", ".cc", ".cpp", ".h", ".hpp", ".js", ".ts")
 XML_PARSERS = re.compile(r"ElementTree|xml\.dom|\blxml\b|rapidxml|\bexpat\b|xml_attr\(")
@@ -110,15 +115,42 @@ def application_includes(src, errors):
             rel = "src/%s/%s" % (app, fname)
             text = open(os.path.join(adir, fname), encoding="utf-8").read()
             for inc in INCLUDE.findall(text):
-                if inc.split("/")[0] in INTERNALS and "/" in inc and (rel, inc) not in APPLICATION_INCLUDES:
+                if inc.split("/")[0] in INTERNALS and "/" in inc and (rel, inc) not in APPLICATION_INCLUDES \
+                        and inc not in PUBLIC_INTERFACES:
                     errors.append('%s includes "%s": applications use the public API (ccomm/ccomm.h) only'
                                   % (rel, inc))
+
+
+def unique_file_names(src, errors):
+    """A file's name says what it is: one name, one file (per-platform units excepted: the
+    same interface in src/common/platform/posix/ and .../windows/)."""
+    seen = {}
+    for name in tracked_code(src):
+        if not name.startswith("src/") or name.startswith("src/common/platform/") or \
+                os.path.basename(name) == "main.cpp":
+            continue
+        seen.setdefault(os.path.basename(name), []).append(name)
+    for base, names in sorted(seen.items()):
+        if len(names) > 1:
+            errors.append("%s: %d files share the name (%s): name each after what it is"
+                          % (base, len(names), ", ".join(names)))
+
+
+def public_interfaces(src, errors):
+    """A public interface is public only if it pulls in no internals."""
+    for header in PUBLIC_INTERFACES:
+        text = open(os.path.join(src, "src", header), encoding="utf-8").read()
+        for inc in INCLUDE.findall(text):
+            errors.append('src/%s includes "%s": a public interface includes standard headers only'
+                          % (header, inc))
 
 
 def main():
     src, build = sys.argv[1], sys.argv[2]
     errors = []
     application_includes(src, errors)
+    public_interfaces(src, errors)
+    unique_file_names(src, errors)
     one_parser_one_table(src, errors)
     # 1. Includes of the bottom modules.
     for module, allowed in BOTTOM.items():
@@ -172,7 +204,7 @@ def main():
         print("layering: " + e)
     if not errors:
         print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
-              "applications use the public API; one parser of signals.xml, one table of type names")
+              "applications use the public API (and config/outline.h); one file per name; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 
 

@@ -199,8 +199,8 @@ BUNDLED = Path(__file__).resolve().parent / "_lib" / LIB_NAMES[0]
 def candidates(env: Mapping[str, str], starts: Sequence[Path],
                bundled: Optional[Path] = None) -> list[Path]:
     """Library paths to try, in order: $CCOMM_LIBRARY, the library bundled in the wheel,
-    $CCOMM_BUILD_DIR/lib, the newest build*/lib of an enclosing source tree. (The system
-    search comes after these.)"""
+    $CCOMM_BUILD_DIR/lib, the newest build/*/lib of an enclosing source tree (build trees
+    are build/NAME/, docs/testing.md). (The system search comes after these.)"""
     out: list[Path] = []
     if env.get("CCOMM_LIBRARY"):
         return [Path(env["CCOMM_LIBRARY"])]
@@ -209,7 +209,7 @@ def candidates(env: Mapping[str, str], starts: Sequence[Path],
         out += [Path(env["CCOMM_BUILD_DIR"]) / LIB_SUBDIR / n for n in LIB_NAMES]
     builds: list[Path] = []
     for root in _repo_roots(starts):
-        for b in root.glob(f"build*/{LIB_SUBDIR}"):
+        for b in root.glob(f"build/*/{LIB_SUBDIR}"):
             if any((b / n).is_file() for n in LIB_NAMES):
                 builds.append(b)
     builds.sort(key=lambda b: max((b / n).stat().st_mtime for n in LIB_NAMES if (b / n).is_file()),

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// Node summaries: building and sending this node's (supervision tick), applying the
-// other nodes' (receive thread). See system_view.h and docs/protocol.md, "Node summary".
-#include "daemon/system_view.h"
+// The system view, ccommd's side: building and sending this node's summary (supervision
+// tick), writing the other nodes' into the view (receive thread). See system_view_writer.h and docs/protocol.md, "Node summary".
+#include "daemon/system_view_writer.h"
 
 #include <arpa/inet.h>
 #include <string.h>
@@ -36,7 +36,7 @@ uint64_t AliveTimeoutNs(uint64_t interval_ns, uint32_t peer_timeout_ms) {
 
 }  // namespace
 
-int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind, bool force_udp,
+int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind, bool force_udp,
                       store::Segment* segment, Transport* transport, const auth::FrameAuth* auth, int gid,
                       std::string* error) {
   cfg_ = &cfg;
@@ -113,7 +113,7 @@ int SystemView::Start(const SystemConfig& cfg, uint32_t self, TransportKind kind
   return 0;
 }
 
-void SystemView::Snapshot(uint64_t now) {
+void SystemViewWriter::Snapshot(uint64_t now) {
   const double dt = now > cycle_start_ns_ ? static_cast<double>(now - cycle_start_ns_) : 0;
   for (Reported& rep : reported_) {
     const store::SignalStats& st = segment_->stats(rep.id);
@@ -126,7 +126,7 @@ void SystemView::Snapshot(uint64_t now) {
   cycle_start_ns_ = now;
 }
 
-uint32_t SystemView::Tick(uint64_t now) {
+uint32_t SystemViewWriter::Tick(uint64_t now) {
   for (Reported& rep : reported_) {  // when did a produced signal last change (tick resolution)
     if (rep.role != wire::kRoleProduced) continue;
     const uint64_t w = segment_->stats(rep.id).writes.load(std::memory_order_relaxed);
@@ -215,7 +215,7 @@ uint32_t SystemView::Tick(uint64_t now) {
   return sent;
 }
 
-void SystemView::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now) {
+void SystemViewWriter::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now) {
   view_.BeginWrite(self_);
   view_.SetNodeWord(self_, store::kVwLastRxNs, now);
   view_.SetNodeWord(self_, store::kVwTimeoutNs, AliveTimeoutNs(interval_ns_, cfg_->network.peer_timeout_ms));
@@ -234,7 +234,7 @@ void SystemView::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32
   view_.EndWrite(self_);
 }
 
-SystemView::Verdict SystemView::Receive(const uint8_t* frame, const wire::FrameHeader& h, uint64_t now,
+SystemViewWriter::Verdict SystemViewWriter::Receive(const uint8_t* frame, const wire::FrameHeader& h, uint64_t now,
                                         const PeerAddress& from) {
   store::ViewHeader* vh = view_.mutable_header();
   Verdict v = Verdict::kApplied;
@@ -309,14 +309,14 @@ SystemView::Verdict SystemView::Receive(const uint8_t* frame, const wire::FrameH
 // daemon counters of the same meaning as for data frames.
 void Daemon::HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from) {
   switch (view_.Receive(buf, h, now, from)) {
-    case SystemView::Verdict::kApplied: Count(store::kFramesRx, std::memory_order_release); break;
-    case SystemView::Verdict::kOld: Count(store::kFramesRx); break;  // a duplicate, like data ones
-    case SystemView::Verdict::kOwn: break;
-    case SystemView::Verdict::kUnknownSender: Count(store::kFramesUnknownSender); break;
-    case SystemView::Verdict::kWrongSource: Count(store::kFramesWrongSource); break;
-    case SystemView::Verdict::kNotForUs: Count(store::kFramesNotForUs); break;
-    case SystemView::Verdict::kWrongHash: Count(store::kFramesWrongHash); break;
-    case SystemView::Verdict::kUnknownSignal: Count(store::kEntriesUnknownSignal); break;
+    case SystemViewWriter::Verdict::kApplied: Count(store::kFramesRx, std::memory_order_release); break;
+    case SystemViewWriter::Verdict::kOld: Count(store::kFramesRx); break;  // a duplicate, like data ones
+    case SystemViewWriter::Verdict::kOwn: break;
+    case SystemViewWriter::Verdict::kUnknownSender: Count(store::kFramesUnknownSender); break;
+    case SystemViewWriter::Verdict::kWrongSource: Count(store::kFramesWrongSource); break;
+    case SystemViewWriter::Verdict::kNotForUs: Count(store::kFramesNotForUs); break;
+    case SystemViewWriter::Verdict::kWrongHash: Count(store::kFramesWrongHash); break;
+    case SystemViewWriter::Verdict::kUnknownSignal: Count(store::kEntriesUnknownSignal); break;
   }
 }
 

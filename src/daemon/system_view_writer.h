@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// One view of the whole system: every node's ccommd sends a short summary of itself
-// (wire/summary.h) to the other nodes, rate-limited, from the supervision tick (never the
-// real-time loops), and stores the summaries it receives in the view object
-// (store/view.h) that `ccomm stats --all` reads through libccomm.
+// ccommd's side of the system view (every node as it reports itself; the one name of the
+// concept, docs/design.md): every node's ccommd sends a node summary, its part of the
+// view (wire/summary.h), to the other nodes, rate-limited, from the supervision tick
+// (never the real-time loops), and writes the summaries it receives into the view object
+// (store/view.h). The reading side is libccomm's ccomm_view_* (client/system_view_reader.cpp),
+// which `ccomm stats --all` prints.
 //
 // Threads: Tick() runs on the main thread and writes only this node's record; Receive()
 // runs on the receive thread and writes only other nodes' records (the view's seqlock is
@@ -22,7 +24,7 @@
 
 namespace ccomm {
 
-class SystemView {
+class SystemViewWriter {
  public:
   /// What Receive() did with a summary frame; the daemon counts the refusals in its
   /// usual counters (same meaning as for data frames).

@@ -103,6 +103,10 @@ int PinToCpu(int cpu);
 int SocketDrops(int fd, uint32_t* drops);
 /// Sleeps `ns` nanoseconds (not [rt]: a syscall; for idle and back-off waits).
 void SleepNs(uint64_t ns);
+/// Sleeps until MonotonicNs() reaches `deadline_ns` (absolute: a periodic loop keeps its
+/// period however long each cycle took); a signal may end it early. Not [rt]: a syscall;
+/// for tools' cycle timing.
+void SleepUntilNs(uint64_t deadline_ns);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 
@@ -117,6 +121,12 @@ int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uin
 bool GlobMatch(const char* pattern, const char* name);
 /// Hostname (for the default node name); false on error.
 bool HostName(char* buf, size_t cap);
+/// Dotted-quad IPv4 text to an address in network byte order (inet_pton); false if
+/// `text` is not one. Start-up only (the Windows unit starts Winsock on first use).
+bool ParseIpv4(const char* text, uint32_t* network_order);
+/// The id of group `name` (getgrnam), or -1 if there is none (always on Windows, where a
+/// segment's access follows the mapping's namespace, docs/install.md). Start-up only.
+int NamedGroupId(const char* name);
 
 }  // namespace platform
 

@@ -69,6 +69,12 @@ int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
 int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
                      Transport* out, std::string* error);
 
+/// False where raw Ethernet is not built (Windows: raw_ethernet_none.cpp); then
+/// OpenRawTransport fails with RawEthernetUnavailable's message.
+extern const bool kRawEthernetBuilt;
+/// "node 'X' uses transport=\"raw\": raw Ethernet is Linux-only; ..." (and what to do).
+std::string RawEthernetUnavailable(const NodeConfig& self);
+
 /// Multicast fan-out: the group node `node_id` sends to (docs/protocol.md, "Fan-out"):
 /// raw MAC 03:63:63:6d:00:ID, UDP multicast_base + ID on udp_port.
 PeerAddress GroupAddressFor(const NetworkConfig& net, uint32_t node_id, TransportKind kind);

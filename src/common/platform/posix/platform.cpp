@@ -5,7 +5,9 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <arpa/inet.h>
 #include <fnmatch.h>
+#include <grp.h>
 #include <linux/futex.h>
 #include <linux/sock_diag.h>
 #include <pthread.h>
@@ -137,6 +139,12 @@ int PinToCpu(int cpu) {
   return -pthread_setaffinity_np(pthread_self(), sizeof set, &set);
 }
 
+void SleepUntilNs(uint64_t deadline_ns) {
+  const struct timespec ts = {static_cast<time_t>(deadline_ns / 1000000000ull),
+                              static_cast<long>(deadline_ns % 1000000000ull)};
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);  // a signal ends it early (Ctrl-C)
+}
+
 int SocketDrops(int fd, uint32_t* drops) {
   uint32_t mem[SK_MEMINFO_VARS] = {};
   socklen_t len = sizeof mem;
@@ -179,6 +187,18 @@ int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uin
 }
 
 bool GlobMatch(const char* pattern, const char* name) { return fnmatch(pattern, name, 0) == 0; }
+
+bool ParseIpv4(const char* text, uint32_t* network_order) {
+  struct in_addr a;
+  if (inet_pton(AF_INET, text, &a) != 1) return false;
+  *network_order = a.s_addr;
+  return true;
+}
+
+int NamedGroupId(const char* name) {
+  const struct group* g = getgrnam(name);
+  return g ? static_cast<int>(g->gr_gid) : -1;
+}
 
 bool HostName(char* buf, size_t cap) {
   if (gethostname(buf, cap) != 0) return false;

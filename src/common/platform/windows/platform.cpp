@@ -21,6 +21,7 @@
 
 // clang-format off
 #include <winsock2.h>  // before windows.h
+#include <ws2tcpip.h>
 #include <windows.h>
 // clang-format on
 
@@ -465,6 +466,12 @@ bool GlobMatch(const char* p, const char* n) {
   return !*n;
 }
 
+void SleepUntilNs(uint64_t deadline_ns) {
+  // No absolute waitable timer on the QPC clock: the rest of the period, relative.
+  const uint64_t now = MonotonicNs();
+  if (deadline_ns > now) SleepNs(deadline_ns - now);
+}
+
 bool HostName(char* buf, size_t cap) {
   DWORD n = static_cast<DWORD>(cap);
   if (!GetComputerNameExA(ComputerNameDnsHostname, buf, &n)) return false;
@@ -473,6 +480,15 @@ bool HostName(char* buf, size_t cap) {
     if (*c >= 'A' && *c <= 'Z') *c = static_cast<char>(*c - 'A' + 'a');
   return buf[0] != '\0';
 }
+
+bool ParseIpv4(const char* text, uint32_t* network_order) {
+  struct in_addr a;
+  if (InetPtonA(AF_INET, text, &a) != 1) return false;  // needs no WSAStartup
+  *network_order = a.s_addr;
+  return true;
+}
+
+int NamedGroupId(const char* /*name*/) { return -1; }
 
 }  // namespace platform
 }  // namespace ccomm

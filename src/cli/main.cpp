@@ -17,7 +17,7 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
-#include "common/platform.h"
+#include "tools/app_os.h"
 
 namespace {
 
@@ -223,8 +223,8 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
     fprintf(stderr, "ccomm pub: %s: %s\n", d.name, err.c_str());
     return 1;
   }
-  uint64_t next = ccomm::platform::MonotonicNs();
-  const uint64_t period_ns = rate > 0 ? static_cast<uint64_t>(1e9 / rate) : 0;
+  int64_t next = ccomm_now();
+  const int64_t period_ns = rate > 0 ? static_cast<int64_t>(1e9 / rate) : 0;
   for (long i = 0; i < count && !g_stop; ++i) {
     int r = ccomm_write(c, s, buf.data(), buf.size());
     if (r != 0) {
@@ -233,7 +233,7 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
     }
     if (period_ns && i + 1 < count) {
       next += period_ns;
-      ccomm::platform::SleepUntilNs(next);
+      ccomm::app::SleepUntilNs(next);
     }
   }
   return 0;

@@ -5,11 +5,11 @@
 // (src/common/CMakeLists.txt), never #ifdefs inside functions:
 //   platform/posix/platform.cpp    Linux (glibc; Xenomai's POSIX skin wraps it)
 //   platform/windows/platform.cpp  Windows x64 (named file mappings, named events)
-// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's Linux-only services have a file each that
-// is their platform layer: transport_raw.cpp / transport_udp.cpp (sockets),
-// privileges.cpp (capabilities, prctl), auth.cpp (the key file), config.cpp (reading
-// signals.xml). Functions marked [rt] are safe on a real-time path: no allocation, no
-// locks, and no syscall except where stated.
+// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's
+// own OS code (sockets, interfaces, privileges, the key file, ptp4l, stop requests) has
+// one whole file per platform in src/daemon (daemon/sources.cmake, docs/design.md), and
+// config.cpp reads signals.xml through ReadRegularFile. Functions marked [rt] are safe on
+// a real-time path: no allocation, no locks, and no syscall except where stated.
 #pragma once
 
 #include <cstddef>
@@ -103,10 +103,6 @@ int PinToCpu(int cpu);
 int SocketDrops(int fd, uint32_t* drops);
 /// Sleeps `ns` nanoseconds (not [rt]: a syscall; for idle and back-off waits).
 void SleepNs(uint64_t ns);
-/// Sleeps until MonotonicNs() reaches `deadline_ns` (absolute: a periodic loop keeps its
-/// period however long each cycle took); a signal may end it early. Not [rt]: a syscall;
-/// for tools' cycle timing.
-void SleepUntilNs(uint64_t deadline_ns);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 

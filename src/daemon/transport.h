@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // One transport per file behind a short function table (LCM style): raw Ethernet
-// (transport_raw.cpp) and UDP (transport_udp.cpp). Each keeps its own state (socket,
+// (transport_raw.cpp; raw_ethernet_none.cpp where it is not built) and UDP
+// (transport_udp.cpp; transport_udp_windows.cpp on Windows). Each keeps its own state (socket,
 // interface, port) behind an opaque pointer; ccommd sees only the table. ccommd opens
 // one at start-up; send and recv are the only calls on its real-time paths and never
 // allocate. Each transport file is the platform layer of its transport (sockets).

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
-#include "common/platform.h"
+#include "tools/app_os.h"
 
 namespace {
 
@@ -64,7 +64,7 @@ struct Options {
   int cpu = -1;
 };
 
-uint64_t Now() { return ccomm::platform::MonotonicNs(); }
+uint64_t Now() { return static_cast<uint64_t>(ccomm_now()); }
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -144,8 +144,8 @@ void* Receiver(void* arg) {
       if (!is_event[i]) break;
     }
   }
-  if (s->prio > 0) ccomm::platform::SetFifoPriority(s->prio);  // best effort, reported by main
-  if (s->cpu >= 0) ccomm::platform::PinToCpu(s->cpu);
+  if (s->prio > 0) ccomm::app::SetFifoPriority(s->prio);  // best effort, reported by main
+  if (s->cpu >= 0) ccomm::app::PinToCpu(s->cpu);
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
@@ -303,14 +303,14 @@ int main(int argc, char** argv) {
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   s.last_hop.reserve(s.samples.capacity());
-  ccomm::platform::LockAllMemory();  // best effort
+  ccomm::app::LockMemory();  // best effort
 
   uint64_t start = Now();
   s.warmup_until = start + static_cast<uint64_t>(o.warmup * 1e9);
   pthread_t rx;
   pthread_create(&rx, nullptr, Receiver, &s);
   if (o.prio > 0) {
-    if (ccomm::platform::SetFifoPriority(o.prio) != 0)
+    if (ccomm::app::SetFifoPriority(o.prio) != 0)
       fprintf(stderr, "ccomm-latency: SCHED_FIFO refused; running SCHED_OTHER\n");
   }
   const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
@@ -318,7 +318,7 @@ int main(int argc, char** argv) {
   uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
   for (uint64_t k = 1;; ++k) {
     next += period;
-    ccomm::platform::SleepUntilNs(next);
+    ccomm::app::SleepUntilNs(static_cast<int64_t>(next));
     if (Now() >= end) break;
     if (s.echo) continue;  // echo only answers, from the receive thread
     s.send_time[k % kHistory] = Now();

@@ -97,7 +97,7 @@ check "Linux ccommd and ccommd.exe (Wine) up, each sees the other as a peer" pee
 kill -0 $lpid 2>/dev/null && kill -0 $wpid 2>/dev/null || return 0
 
 # Per-signal tx (sending node) and rx/lost (receiving node) sums, from two stats snapshots.
-counters() {  # BEFORE_TX AFTER_TX BEFORE_RX AFTER_RX: prints "tx rx lost mismatched"
+counters() {  # BEFORE_TX AFTER_TX BEFORE_RX AFTER_RX: prints "tx rx lost mismatched signals coalesced"
   python3 - "$@" <<'PY'
 import json, sys
 btx, atx, brx, arx = (json.loads(open(f).read()) for f in sys.argv[1:5])
@@ -106,9 +106,12 @@ btx, atx, brx, arx = sig(btx), sig(atx), sig(brx), sig(arx)
 names = [n for n in arx if arx[n]["rx"] or atx[n]["tx"] > btx[n]["tx"]]
 tx = sum(atx[n]["tx"] - btx[n]["tx"] for n in names)
 rx = sum(arx[n]["rx"] - brx[n]["rx"] for n in names)
-lost = sum(arx[n]["lost"] - brx[n]["lost"] for n in names)
+# A gap in a signal's sequence numbers is a lost value unless the sending ccommd itself
+# replaced it by a newer one before sending (coalesced: it ran late), as scripts/demo counts.
+lost = sum(max((arx[n]["lost"] - brx[n]["lost"]) - (atx[n]["coalesced"] - btx[n]["coalesced"]), 0) for n in names)
+coalesced = sum(atx[n]["coalesced"] - btx[n]["coalesced"] for n in names)
 bad = [n for n in names if atx[n]["tx"] - btx[n]["tx"] != arx[n]["rx"] - brx[n]["rx"]]
-print(tx, rx, lost, len(bad), len(names))
+print(tx, rx, lost, len(bad), len(names), coalesced)
 PY
 }
 setup_simulation() {
@@ -133,9 +136,11 @@ setup_simulation() {
   local p50 sent recv llost
   read -r p50 sent recv llost < <(python3 -c 'import json,sys; r=json.load(open(sys.argv[1]));
 print(r["p50_ns"], r["sent"], r["received"], r["lost"])' "$W/ping.json")
-  read -r txw rxw lostw badw nw <<<"$to_w"; read -r txl rxl lostl badl nl <<<"$to_l"
-  say "  Linux -> Windows: $nw signals, $txw values sent, $rxw received, $lostw lost, $badw signals with rx != tx"
-  say "  Windows -> Linux: $nl signals, $txl values sent, $rxl received, $lostl lost, $badl signals with rx != tx"
+  read -r txw rxw lostw badw nw cow <<<"$to_w"; read -r txl rxl lostl badl nl col <<<"$to_l"
+  say "  Linux -> Windows: $nw signals, $txw values sent, $rxw received, $lostw lost, $badw signals with rx != tx" \
+      "($cow coalesced by the sending ccommd: it ran late)"
+  say "  Windows -> Linux: $nl signals, $txl values sent, $rxl received, $lostl lost, $badl signals with rx != tx" \
+      "($col coalesced)"
   say "  ping (36 doubles) / echo (9 doubles) at 1 kHz, 10 s measured: $sent cycles, $recv echoed whole, $llost" \
       "cycles not echoed whole; p50 one-way (RTT/2) $(awk -v n="$p50" 'BEGIN{printf "%.0f", n/1000}') us" \
       "(Wine timing is not Windows timing)"

@@ -139,12 +139,6 @@ int PinToCpu(int cpu) {
   return -pthread_setaffinity_np(pthread_self(), sizeof set, &set);
 }
 
-void SleepUntilNs(uint64_t deadline_ns) {
-  const struct timespec ts = {static_cast<time_t>(deadline_ns / 1000000000ull),
-                              static_cast<long>(deadline_ns % 1000000000ull)};
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);  // a signal ends it early (Ctrl-C)
-}
-
 int SocketDrops(int fd, uint32_t* drops) {
   uint32_t mem[SK_MEMINFO_VARS] = {};
   socklen_t len = sizeof mem;

@@ -466,12 +466,6 @@ bool GlobMatch(const char* p, const char* n) {
   return !*n;
 }
 
-void SleepUntilNs(uint64_t deadline_ns) {
-  // No absolute waitable timer on the QPC clock: the rest of the period, relative.
-  const uint64_t now = MonotonicNs();
-  if (deadline_ns > now) SleepNs(deadline_ns - now);
-}
-
 bool HostName(char* buf, size_t cap) {
   DWORD n = static_cast<DWORD>(cap);
   if (!GetComputerNameExA(ComputerNameDnsHostname, buf, &n)) return false;

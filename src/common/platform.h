@@ -132,5 +132,8 @@ enum class LogLevel { kError = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug =
 void Log(LogLevel level, const char* fmt, ...) CCOMM_PRINTF_FORMAT(2, 3);
 void SetLogVerbosity(LogLevel max_level);
 void SetLogPrefixes(bool sd_prefixes);
+/// Appends log lines to the file `path` instead of stderr (a Windows service has no
+/// stderr: service_windows.cpp). False if it cannot be opened.
+bool SetLogFile(const char* path);
 
 }  // namespace ccomm

@@ -20,6 +20,7 @@
 #include "daemon/sd_notify.h"
 #include "daemon/stop_request.h"
 #include "daemon/segment_builder.h"
+#include "daemon/service.h"
 #include "daemon/transport.h"
 #include "store/layout.h"
 #include "wire/wire.h"
@@ -72,7 +73,8 @@ void* RxThread(void* d) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The daemon; main() runs it, as a Windows service with --service (service.h).
+int RunDaemon(int argc, char** argv) {
   using namespace ccomm;
   DaemonOptions opt;
   int verbosity = 6;
@@ -276,3 +278,5 @@ int main(int argc, char** argv) {
   daemon.Shutdown();
   return 0;
 }
+
+int main(int argc, char** argv) { return ccomm::service::Main(argc, argv, RunDaemon); }

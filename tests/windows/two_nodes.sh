@@ -39,6 +39,47 @@ check_raw() {
 }
 check "ccommd.exe --check / start: a Windows node on raw Ethernet is refused (Linux-only)" check_raw
 
+# ---- a2. ccommd.exe as a Windows service (Wine's services.exe) ---------------------------
+# Wine ends its services when its last ordinary process exits: a console (cmd reading a
+# fifo held open) keeps the session while the service runs.
+svc_state() { wine sc query "$1" 2>/dev/null | tr -d '\r' | sed -n 's/^ *\(STATE\|SERVICE_EXIT_CODE\) *: \([0-9]*\).*/\2/p' | tr '\n' ' '; }
+svc_wait() {  # NAME STATE: waits (bounded) until the service is in STATE (4 running, 1 stopped)
+  local deadline=$((SECONDS + 60))
+  until [[ $(svc_state "$1") == "$2 "* ]]; do [[ $SECONDS -lt $deadline ]] || return 1; sleep 0.3; done
+}
+service() {
+  local name=ccommd-t$$ log=$WBIN/ccommd.log keeper rc=0
+  rm -f "$log"
+  mkfifo "$W/keep"
+  "$WINE" cmd <"$W/keep" >/dev/null 2>&1 &
+  keeper=$!
+  exec 8>"$W/keep"  # cmd ends when this closes
+  wine sc create "$name" binPath= "$(winepath_of "$WBIN/ccommd.exe") --service -c $(winepath_of "$SRC/examples/local-only.xml") --node robot --no-rt" >/dev/null &&
+    wine sc start "$name" >/dev/null && svc_wait "$name" 4 || rc=1
+  local deadline=$((SECONDS + 60))
+  until [[ $rc -ne 0 ]] || wine "$WBIN/ccomm.exe" --node robot stats --json 2>/dev/null | grep -q '"daemon_alive":true'; do
+    [[ $SECONDS -lt $deadline ]] || { echo "service running, but no live segment"; rc=1; }
+    sleep 0.3
+  done
+  [[ $rc -eq 0 ]] && { wine sc stop "$name" >/dev/null; svc_wait "$name" 1 || rc=1; }
+  local state; state=$(svc_state "$name")
+  say "  service: after sc stop: state/exit code '$state'; log: $(grep -c . "$log" 2>/dev/null) lines, last '$(tail -1 "$log" 2>/dev/null | tr -d '\r')'"
+  local text; text=$(tr -d '\r' <"$log" 2>/dev/null)  # the C runtime's text mode writes CR LF
+  [[ $state == "1 0 " ]] && grep -q "node 'robot'" <<<"$text" && [[ $(tail -1 <<<"$text") == stopping ]] || rc=1
+  # A bad configuration: the service stops at once with ccommd's exit status 1.
+  wine sc delete "$name" >/dev/null
+  wine sc create "$name" binPath= "$(winepath_of "$WBIN/ccommd.exe") --service -c $(winepath_of "$W/missing.xml") --no-rt" >/dev/null &&
+    wine sc start "$name" >/dev/null
+  svc_wait "$name" 1 && state=$(svc_state "$name")
+  say "  service with a missing config: state/exit code '$state'"
+  [[ $state == "1 1 " ]] || rc=1
+  wine sc delete "$name" >/dev/null
+  exec 8>&-
+  wait "$keeper" 2>/dev/null
+  return $rc
+}
+check "ccommd.exe --service under Wine's service manager: sc start runs it, sc stop stops it cleanly, a bad config stops it with status 1" service
+
 if [[ ! -x $LBIN/ccommd || ! -x $LBIN/ccomm || ! -x $LBIN/ccomm-latency ]]; then
   say "SKIP Wine <-> Linux checks: no Linux release build in build/release (scripts/build release)"
   return 0

@@ -39,6 +39,37 @@ install(TARGETS ccomm RUNTIME DESTINATION bin LIBRARY DESTINATION lib ARCHIVE DE
 install(FILES ${CMAKE_CURRENT_LIST_DIR}/include/ccomm/ccomm.h ${CMAKE_CURRENT_LIST_DIR}/include/ccomm/ccomm.hpp
         DESTINATION include/ccomm)
 
+# ccommd.exe: the daemon with the Windows units of its platform code (daemon/sources.cmake);
+# UDP only (raw Ethernet is Linux-only), no libsodium, no systemd.
+set(_dm ${CMAKE_CURRENT_LIST_DIR}/daemon)
+include(${_dm}/sources.cmake)
+list(TRANSFORM CCOMM_DAEMON_SOURCES PREPEND ${_dm}/)
+list(TRANSFORM CCOMM_DAEMON_WINDOWS_SOURCES PREPEND ${_dm}/)
+add_library(ccomm_daemon STATIC ${CCOMM_DAEMON_SOURCES} ${CCOMM_DAEMON_WINDOWS_SOURCES}
+            ${_dm}/auth_crypto_none.cpp ${_dm}/sd_notify_none.cpp)
+ccomm_core_target(ccomm_daemon)
+target_link_libraries(ccomm_daemon PUBLIC ccomm_segment_builder ccomm_store ccomm_wire ccomm_config ccomm_platform
+                      iphlpapi ws2_32)
+add_executable(ccommd ${_dm}/main.cpp)
+ccomm_core_target(ccommd)
+target_compile_definitions(ccommd PRIVATE CCOMM_VERSION="${PROJECT_VERSION}")
+target_link_libraries(ccommd PRIVATE ccomm_daemon)
+install(TARGETS ccommd RUNTIME DESTINATION bin)
+
+# ccomm.exe, the command line tool, and ccomm-latency.exe, against ccomm.dll.
+set(_cli ${CMAKE_CURRENT_LIST_DIR}/cli)
+add_executable(ccomm_cli ${_cli}/main.cpp ${_cli}/stats.cpp ${_cli}/stats_all.cpp ${_cli}/values.cpp
+               ${_cli}/external_windows.cpp ${CMAKE_CURRENT_LIST_DIR}/tools/app_os_windows.cpp)
+set_target_properties(ccomm_cli PROPERTIES OUTPUT_NAME ccomm)
+ccomm_core_target(ccomm_cli)
+target_compile_definitions(ccomm_cli PRIVATE CCOMM_DATADIR="share/ccomm")
+target_link_libraries(ccomm_cli PRIVATE ccomm ccomm_config)
+install(TARGETS ccomm_cli RUNTIME DESTINATION bin)
+add_executable(ccomm-latency ${CMAKE_CURRENT_LIST_DIR}/tools/latency.cpp ${CMAKE_CURRENT_LIST_DIR}/tools/app_os_windows.cpp)
+target_include_directories(ccomm-latency PRIVATE ${PROJECT_SOURCE_DIR}/src)
+target_link_libraries(ccomm-latency PRIVATE ccomm Threads::Threads)
+install(TARGETS ccomm-latency RUNTIME DESTINATION bin)
+
 # The unit tests that apply to a PC: the ones of the modules above that need no Linux
 # sockets or daemon (tests/windows/run runs them under Wine).
 if(CCOMM_BUILD_TESTS)

@@ -17,6 +17,7 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
+#include "tools/app_os.h"
 
 namespace {
 
@@ -222,9 +223,8 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
     fprintf(stderr, "ccomm pub: %s: %s\n", d.name, err.c_str());
     return 1;
   }
-  struct timespec next;
-  clock_gettime(CLOCK_MONOTONIC, &next);
-  long period_ns = rate > 0 ? static_cast<long>(1e9 / rate) : 0;
+  int64_t next = ccomm_now();
+  const int64_t period_ns = rate > 0 ? static_cast<int64_t>(1e9 / rate) : 0;
   for (long i = 0; i < count && !g_stop; ++i) {
     int r = ccomm_write(c, s, buf.data(), buf.size());
     if (r != 0) {
@@ -232,79 +232,27 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
       return 1;
     }
     if (period_ns && i + 1 < count) {
-      next.tv_nsec += period_ns;
-      while (next.tv_nsec >= 1000000000) { next.tv_nsec -= 1000000000; next.tv_sec++; }
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+      next += period_ns;
+      ccomm::app::SleepUntilNs(next);
     }
   }
   return 0;
 }
 
-int CmdGen(const char* node, int argc, char** argv) {
-  if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
-    fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
-    return 2;
-  }
-  // The generator is a Python script installed with the integrations.
-  const char* gen = getenv("CCOMM_GEN_20SIM4C");
-  std::string path = gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py";
-  // It reads signals.xml through `ccommd --check --json`: in a build tree the ccommd beside
-  // this program, installed the one in sbin (the generator looks there).
-  char self[4096];
-  const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
-  if (!getenv("CCOMM_CCOMMD") && len > 0) {
-    self[len] = '\0';
-    std::string beside(self);
-    beside = beside.substr(0, beside.rfind('/') + 1) + "ccommd";
-    if (access(beside.c_str(), X_OK) == 0) setenv("CCOMM_CCOMMD", beside.c_str(), 1);
-  }
-  std::vector<char*> args;
-  std::string py = "python3";
-  args.push_back(&py[0]);
-  args.push_back(&path[0]);
-  std::string node_opt = "--node";
-  std::string node_name = node ? node : "";
-  if (node) {
-    args.push_back(&node_opt[0]);
-    args.push_back(&node_name[0]);
-  }
-  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
-  args.push_back(nullptr);
-  execvp("python3", args.data());
-  fprintf(stderr, "ccomm gen: cannot run python3 %s: %s\n", path.c_str(), strerror(errno));
-  return 1;
-}
-
-// `ccomm X ARGS` for a command this program does not know runs `ccomm-X ARGS` from PATH
-// (git-style), so tools shipped by other packages (Python, the ROS 2 bridge) are one CLI.
-int RunExternal(const char* node, const char* cmd, int argc, char** argv) {
-  std::string prog = std::string("ccomm-") + cmd;
-  if (node) setenv("CCOMM_NODE", node, 1);
-  std::vector<char*> args;
-  args.push_back(&prog[0]);
-  for (int i = 1; i < argc; ++i) args.push_back(argv[i]);
-  args.push_back(nullptr);
-  execvp(prog.c_str(), args.data());
-  if (errno == ENOENT) {
-    // The tools that ship elsewhere say where they come from.
-    const char* hint = !strcmp(cmd, "ros2") ? "ccomm-ros2 is built when Cyclone DDS is found (Debian: cyclonedds-dev, cyclonedds-tools)"
-                       : (!strcmp(cmd, "record") || !strcmp(cmd, "replay")) ? "it comes with the Python package: pip install 'ccomm[record]'"
-                       : !strcmp(cmd, "web") ? "it comes with the Python package: pip install 'ccomm[web]'"
-                       : nullptr;
-    if (hint) {
-      fprintf(stderr, "ccomm: %s is not installed (no %s in PATH): %s\n", cmd, prog.c_str(), hint);
-      return 1;
-    }
-    fprintf(stderr, "ccomm: unknown command '%s' (no %s in PATH)\n%s", cmd, prog.c_str(), kUsage);
-    return 2;
-  }
-  fprintf(stderr, "ccomm: cannot run %s: %s\n", prog.c_str(), strerror(errno));
-  return 1;
-}
-
 }  // namespace
 
 int CmdStats(ccomm_client* c, const char* node, int argc, char** argv);  // stats.cpp
+// Other programs (external_posix.cpp, external_windows.cpp).
+int CmdGen(const char* node, int argc, char** argv);
+int RunExternal(const char* node, const char* cmd, int argc, char** argv, const char* usage);
+
+// The tools that ship elsewhere say where they come from (nullptr: not one of them).
+const char* MissingToolHint(const char* cmd) {
+  return !strcmp(cmd, "ros2") ? "ccomm-ros2 is built when Cyclone DDS is found (Debian: cyclonedds-dev, cyclonedds-tools)"
+         : (!strcmp(cmd, "record") || !strcmp(cmd, "replay")) ? "it comes with the Python package: pip install 'ccomm[record]'"
+         : !strcmp(cmd, "web") ? "it comes with the Python package: pip install 'ccomm[web]'"
+         : nullptr;
+}
 
 int main(int argc, char** argv) {
   const char* node = nullptr;
@@ -329,7 +277,7 @@ int main(int argc, char** argv) {
   if (strcmp(cmd, "gen") == 0) return CmdGen(node, sub_argc, sub_argv);
   if (strcmp(cmd, "help") == 0) { fputs(kUsage, stdout); return 0; }
   if (strcmp(cmd, "list") && strcmp(cmd, "echo") && strcmp(cmd, "pub") && strcmp(cmd, "stats")) {
-    return RunExternal(node, cmd, sub_argc, sub_argv);
+    return RunExternal(node, cmd, sub_argc, sub_argv, kUsage);
   }
   // `ccomm echo --help` prints help; it does not need (or try to reach) a daemon.
   for (int i = 1; i < sub_argc; ++i) {

@@ -5,11 +5,11 @@
 // (src/common/CMakeLists.txt), never #ifdefs inside functions:
 //   platform/posix/platform.cpp    Linux (glibc; Xenomai's POSIX skin wraps it)
 //   platform/windows/platform.cpp  Windows x64 (named file mappings, named events)
-// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's Linux-only services have a file each that
-// is their platform layer: transport_raw.cpp / transport_udp.cpp (sockets),
-// privileges.cpp (capabilities, prctl), auth.cpp (the key file), config.cpp (reading
-// signals.xml). Functions marked [rt] are safe on a real-time path: no allocation, no
-// locks, and no syscall except where stated.
+// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's
+// own OS code (sockets, interfaces, privileges, the key file, ptp4l, stop requests) has
+// one whole file per platform in src/daemon (daemon/sources.cmake, docs/design.md), and
+// config.cpp reads signals.xml through ReadRegularFile. Functions marked [rt] are safe on
+// a real-time path: no allocation, no locks, and no syscall except where stated.
 #pragma once
 
 #include <cstddef>
@@ -117,6 +117,12 @@ int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uin
 bool GlobMatch(const char* pattern, const char* name);
 /// Hostname (for the default node name); false on error.
 bool HostName(char* buf, size_t cap);
+/// Dotted-quad IPv4 text to an address in network byte order (inet_pton); false if
+/// `text` is not one. Start-up only (the Windows unit starts Winsock on first use).
+bool ParseIpv4(const char* text, uint32_t* network_order);
+/// The id of group `name` (getgrnam), or -1 if there is none (always on Windows, where a
+/// segment's access follows the mapping's namespace, docs/install.md). Start-up only.
+int NamedGroupId(const char* name);
 
 }  // namespace platform
 
@@ -126,5 +132,8 @@ enum class LogLevel { kError = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug =
 void Log(LogLevel level, const char* fmt, ...) CCOMM_PRINTF_FORMAT(2, 3);
 void SetLogVerbosity(LogLevel max_level);
 void SetLogPrefixes(bool sd_prefixes);
+/// Appends log lines to the file `path` instead of stderr (a Windows service has no
+/// stderr: service_windows.cpp). False if it cannot be opened.
+bool SetLogFile(const char* path);
 
 }  // namespace ccomm

@@ -5,9 +5,7 @@
 #include "daemon/segment_builder.h"
 #include "daemon/sd_notify.h"
 
-#include <arpa/inet.h>
 #include <errno.h>
-#include <grp.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -87,7 +85,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
     // UDP frames must come from the peer's own address (rule 2); raw frames carry no
     // address worth checking (any station can send any source MAC).
     if (kind == TransportKind::kUdp && !cfg.nodes[p].ip.empty())
-      inet_pton(AF_INET, cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
+      platform::ParseIpv4(cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
   }
 
   if (fanout_multicast_ && !groups.empty()) {
@@ -110,8 +108,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   }
 
   // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
-  int gid = -1;
-  if (struct group* g = getgrnam("ccomm")) gid = static_cast<int>(g->gr_gid);
+  const int gid = platform::NamedGroupId("ccomm");
   // Two ccommd for one node would both forward and reclaim in one segment: refuse the
   // second (a systemd unit and a hand-started one, say) before it touches anything.
   int holder = 0;

@@ -4,11 +4,9 @@
 #include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <string>
 
@@ -20,7 +18,10 @@
 #include "daemon/privileges.h"
 #include "daemon/ptp_config.h"
 #include "daemon/sd_notify.h"
+#include "daemon/stop_request.h"
 #include "daemon/segment_builder.h"
+#include "daemon/service.h"
+#include "daemon/transport.h"
 #include "store/layout.h"
 #include "wire/wire.h"
 
@@ -61,8 +62,6 @@ const char kUsage[] =
     "Exit status: 0 clean stop or valid config, 1 invalid config, 2 usage, 3 start-up failure.\n"
     "See ccommd(8), docs/config.md and docs/protocol.md.\n";
 
-volatile sig_atomic_t g_stop = 0;
-
 void* TxThread(void* d) {
   static_cast<ccomm::Daemon*>(d)->RunTx();
   return nullptr;
@@ -74,7 +73,8 @@ void* RxThread(void* d) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The daemon; main() runs it, as a Windows service with --service (service.h).
+int RunDaemon(int argc, char** argv) {
   using namespace ccomm;
   DaemonOptions opt;
   int verbosity = 6;
@@ -153,6 +153,21 @@ int main(int argc, char** argv) {
         return 3;
       }
     }
+    // Where raw Ethernet is not built (Windows), this host's node must use UDP. Which node
+    // that is may not be known where the file is checked: then there is nothing to say.
+    if (!kRawEthernetBuilt && !opt.force_udp) {
+      const char* env = getenv("CCOMM_NODE");
+      const std::string name = !opt.node.empty() ? opt.node : env ? env : "";
+      char host[64] = "";
+      if (!platform::HostName(host, sizeof host)) host[0] = '\0';
+      std::string how, why;
+      const int n = IdentifyNode(cfg, name, "--node", host, LocalInterfaces(), &how, &why);
+      if (n >= 0 && cfg.nodes[static_cast<size_t>(n)].transport == TransportKind::kRaw) {
+        const NodeConfig& self = cfg.nodes[static_cast<size_t>(n)];
+        fprintf(stderr, "%s:%d: error: %s\n", opt.config_path.c_str(), self.line, RawEthernetUnavailable(self).c_str());
+        return 1;
+      }
+    }
     printf("%s: ok (%zu nodes, %zu signals, hash %08x)\n", opt.config_path.c_str(), cfg.nodes.size(),
            cfg.signals.size(), cfg.hash);
     return 0;
@@ -195,13 +210,8 @@ int main(int argc, char** argv) {
   opt.node = cfg.nodes[static_cast<size_t>(node)].name;
   Log(LogLevel::kInfo, "this board is node '%s' (%s)", opt.node.c_str(), how.c_str());
 
-  // Signals are handled synchronously by the main thread; the I/O threads block them.
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGHUP);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  // Stop requests are handled synchronously by the main thread (signals: the I/O threads block them).
+  stop::Install();
 
   const NodeConfig& self = cfg.nodes[static_cast<size_t>(node)];
   if (!opt.no_realtime && self.realtime.mlockall) {
@@ -245,10 +255,9 @@ int main(int argc, char** argv) {
   const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
   uint64_t last_ping = 0, last_tx = 0, last_rx = 0;
   for (;;) {
-    struct timespec ts = {0, 10 * 1000 * 1000};
-    int sig = sigtimedwait(&set, nullptr, &ts);
-    if (sig == SIGTERM || sig == SIGINT) break;
-    if (sig == SIGHUP) Log(LogLevel::kNotice, "SIGHUP ignored: restart ccommd to load a new configuration");
+    const stop::Request req = stop::Wait(10);
+    if (req == stop::Request::kStop) break;
+    if (req == stop::Request::kReload) Log(LogLevel::kNotice, "SIGHUP ignored: restart ccommd to load a new configuration");
     uint64_t now = platform::MonotonicNs();
     daemon.Supervise(now);
     // Ping the watchdog only while both I/O loops make progress.
@@ -269,3 +278,5 @@ int main(int argc, char** argv) {
   daemon.Shutdown();
   return 0;
 }
+
+int main(int argc, char** argv) { return ccomm::service::Main(argc, argv, RunDaemon); }

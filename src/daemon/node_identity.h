@@ -11,7 +11,7 @@
 
 namespace ccomm {
 
-/// A local interface's addresses (node_identity.cpp reads them with getifaddrs).
+/// A local interface's addresses (node_interfaces_posix.cpp, node_interfaces_windows.cpp).
 struct LocalInterface {
   std::string name;
   bool has_mac = false;

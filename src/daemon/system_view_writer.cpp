@@ -3,7 +3,6 @@
 // tick), writing the other nodes' into the view (receive thread). See system_view_writer.h and docs/protocol.md, "Node summary".
 #include "daemon/system_view_writer.h"
 
-#include <arpa/inet.h>
 #include <string.h>
 
 #include "common/platform.h"
@@ -82,7 +81,7 @@ int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKin
   for (uint32_t p = 0; p < m; ++p) {
     const TransportKind pk = force_udp ? TransportKind::kUdp : cfg.nodes[p].transport;
     // UDP summaries must come from the sender's own address, as data frames (rule 2).
-    if (pk == TransportKind::kUdp && !cfg.nodes[p].ip.empty()) inet_pton(AF_INET, cfg.nodes[p].ip.c_str(), &senders_[p].ipv4);
+    if (pk == TransportKind::kUdp && !cfg.nodes[p].ip.empty()) platform::ParseIpv4(cfg.nodes[p].ip.c_str(), &senders_[p].ipv4);
     if (p == self || pk != kind || cfg.network.summary_ms == 0 || transport->ops == nullptr) continue;
     if (cfg.network.fanout == Fanout::kMulticast) continue;  // one frame to our group, below
     Dest d;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // One transport per file behind a short function table (LCM style): raw Ethernet
-// (transport_raw.cpp) and UDP (transport_udp.cpp). Each keeps its own state (socket,
+// (transport_raw.cpp; raw_ethernet_none.cpp where it is not built) and UDP
+// (transport_udp.cpp; transport_udp_windows.cpp on Windows). Each keeps its own state (socket,
 // interface, port) behind an opaque pointer; ccommd sees only the table. ccommd opens
 // one at start-up; send and recv are the only calls on its real-time paths and never
 // allocate. Each transport file is the platform layer of its transport (sockets).
@@ -68,6 +69,12 @@ int OpenRawTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
                      Transport* out, std::string* error);
 int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
                      Transport* out, std::string* error);
+
+/// False where raw Ethernet is not built (Windows: raw_ethernet_none.cpp); then
+/// OpenRawTransport fails with RawEthernetUnavailable's message.
+extern const bool kRawEthernetBuilt;
+/// "node 'X' uses transport=\"raw\": raw Ethernet is Linux-only; ..." (and what to do).
+std::string RawEthernetUnavailable(const NodeConfig& self);
 
 /// Multicast fan-out: the group node `node_id` sends to (docs/protocol.md, "Fan-out"):
 /// raw MAC 03:63:63:6d:00:ID, UDP multicast_base + ID on udp_port.

@@ -18,6 +18,9 @@
 #include "wire/wire.h"
 
 namespace ccomm {
+
+const bool kRawEthernetBuilt = true;
+
 namespace {
 
 struct RawState {

@@ -171,36 +171,6 @@ const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, 
 
 }  // namespace
 
-PeerAddress GroupAddressFor(const NetworkConfig& net, uint32_t node_id, TransportKind kind) {
-  PeerAddress a;
-  if (kind == TransportKind::kRaw) {
-    memcpy(a.mac, kGroupMacPrefix, 4);
-    a.mac[4] = static_cast<uint8_t>(node_id >> 8);
-    a.mac[5] = static_cast<uint8_t>(node_id);
-    return a;
-  }
-  const uint8_t* b = net.multicast_base;
-  const uint32_t host = ((uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3]) + node_id;
-  a.ipv4 = htonl(host);
-  a.port = htons(net.udp_port);
-  return a;
-}
-
-bool PeerAddressFor(const NetworkConfig& net, const NodeConfig& peer, TransportKind kind,
-                    PeerAddress* out) {
-  *out = PeerAddress();
-  if (kind == TransportKind::kRaw) {
-    if (peer.has_mac) memcpy(out->mac, peer.mac, 6);
-    return true;
-  }
-  const std::string& ip = peer.multicast.empty() ? peer.ip : peer.multicast;
-  struct in_addr a;
-  if (ip.empty() || inet_pton(AF_INET, ip.c_str(), &a) != 1) return false;
-  out->ipv4 = a.s_addr;
-  out->port = htons(net.udp_port);
-  return true;
-}
-
 int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_timeout_ms,
                      Transport* out, std::string* error) {
   int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);

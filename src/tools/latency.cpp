@@ -16,7 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <time.h>
 
 #include <algorithm>
@@ -25,6 +24,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
+#include "tools/app_os.h"
 
 namespace {
 
@@ -64,11 +64,7 @@ struct Options {
   int cpu = -1;
 };
 
-uint64_t Now() {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
+uint64_t Now() { return static_cast<uint64_t>(ccomm_now()); }
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -148,17 +144,8 @@ void* Receiver(void* arg) {
       if (!is_event[i]) break;
     }
   }
-  if (s->prio > 0) {
-    struct sched_param sp = {};
-    sp.sched_priority = s->prio;
-    pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);  // best effort, reported by main
-  }
-  if (s->cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(s->cpu, &set);
-    pthread_setaffinity_np(pthread_self(), sizeof set, &set);
-  }
+  if (s->prio > 0) ccomm::app::SetFifoPriority(s->prio);  // best effort, reported by main
+  if (s->cpu >= 0) ccomm::app::PinToCpu(s->cpu);
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
@@ -316,16 +303,14 @@ int main(int argc, char** argv) {
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   s.last_hop.reserve(s.samples.capacity());
-  mlockall(MCL_CURRENT | MCL_FUTURE);  // best effort
+  ccomm::app::LockMemory();  // best effort
 
   uint64_t start = Now();
   s.warmup_until = start + static_cast<uint64_t>(o.warmup * 1e9);
   pthread_t rx;
   pthread_create(&rx, nullptr, Receiver, &s);
   if (o.prio > 0) {
-    struct sched_param sp = {};
-    sp.sched_priority = o.prio;
-    if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) != 0)
+    if (ccomm::app::SetFifoPriority(o.prio) != 0)
       fprintf(stderr, "ccomm-latency: SCHED_FIFO refused; running SCHED_OTHER\n");
   }
   const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
@@ -333,8 +318,7 @@ int main(int argc, char** argv) {
   uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
   for (uint64_t k = 1;; ++k) {
     next += period;
-    struct timespec ts = {static_cast<time_t>(next / 1000000000ull), static_cast<long>(next % 1000000000ull)};
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+    ccomm::app::SleepUntilNs(static_cast<int64_t>(next));
     if (Now() >= end) break;
     if (s.echo) continue;  // echo only answers, from the receive thread
     s.send_time[k % kHistory] = Now();

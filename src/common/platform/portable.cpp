@@ -19,9 +19,17 @@ void PrefaultStack(size_t bytes) {
 
 static LogLevel g_max_level = LogLevel::kInfo;
 static bool g_sd_prefixes = false;
+static FILE* g_log_file = nullptr;  // nullptr: stderr
 
 void SetLogVerbosity(LogLevel max_level) { g_max_level = max_level; }
 void SetLogPrefixes(bool sd_prefixes) { g_sd_prefixes = sd_prefixes; }
+bool SetLogFile(const char* path) {
+  FILE* f = fopen(path, "a");
+  if (!f) return false;
+  setvbuf(f, nullptr, _IOLBF, 1024);
+  g_log_file = f;
+  return true;
+}
 
 void Log(LogLevel level, const char* fmt, ...) {
   if (static_cast<int>(level) > static_cast<int>(g_max_level)) return;
@@ -32,7 +40,7 @@ void Log(LogLevel level, const char* fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
   va_end(ap);
-  fprintf(stderr, "%s\n", line);
+  fprintf(g_log_file ? g_log_file : stderr, "%s\n", line);
 }
 
 }  // namespace ccomm

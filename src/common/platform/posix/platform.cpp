@@ -5,7 +5,9 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <arpa/inet.h>
 #include <fnmatch.h>
+#include <grp.h>
 #include <linux/futex.h>
 #include <linux/sock_diag.h>
 #include <pthread.h>
@@ -179,6 +181,18 @@ int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uin
 }
 
 bool GlobMatch(const char* pattern, const char* name) { return fnmatch(pattern, name, 0) == 0; }
+
+bool ParseIpv4(const char* text, uint32_t* network_order) {
+  struct in_addr a;
+  if (inet_pton(AF_INET, text, &a) != 1) return false;
+  *network_order = a.s_addr;
+  return true;
+}
+
+int NamedGroupId(const char* name) {
+  const struct group* g = getgrnam(name);
+  return g ? static_cast<int>(g->gr_gid) : -1;
+}
 
 bool HostName(char* buf, size_t cap) {
   if (gethostname(buf, cap) != 0) return false;

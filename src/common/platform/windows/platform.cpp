@@ -21,6 +21,7 @@
 
 // clang-format off
 #include <winsock2.h>  // before windows.h
+#include <ws2tcpip.h>
 #include <windows.h>
 // clang-format on
 
@@ -473,6 +474,15 @@ bool HostName(char* buf, size_t cap) {
     if (*c >= 'A' && *c <= 'Z') *c = static_cast<char>(*c - 'A' + 'a');
   return buf[0] != '\0';
 }
+
+bool ParseIpv4(const char* text, uint32_t* network_order) {
+  struct in_addr a;
+  if (InetPtonA(AF_INET, text, &a) != 1) return false;  // needs no WSAStartup
+  *network_order = a.s_addr;
+  return true;
+}
+
+int NamedGroupId(const char* /*name*/) { return -1; }
 
 }  // namespace platform
 }  // namespace ccomm

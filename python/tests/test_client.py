@@ -221,6 +221,8 @@ def test_system_view(client: Client) -> None:
     nodes = {n["name"]: n for n in v["nodes"]}
     me, remote = nodes["pytest"], nodes["remote"]
     assert me["self"] and me["reported"] and me["alive"] and me["peers_alive"] == []
+    # No ptp4l answers this test's ccommd: its clock is "none", with no error bound.
+    assert me["clock"] == {"state": "none", "error_ns": None}
     assert not remote["reported"] and not remote["alive"] and remote["signals"] == []
     sigs = {s["name"]: s for s in me["signals"]}
     assert sigs["d"]["role"] == "producer" and sigs["remote_x"]["role"] == "consumer"

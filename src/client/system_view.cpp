@@ -20,6 +20,7 @@ namespace {
 
 namespace st = ccomm::store;
 constexpr uint32_t kNoAge = 0xFFFFFFFFu;  // wire::kSummaryNoAge
+constexpr uint64_t kNoClockError = 0xFFFFFFFFu;  // wire::kSummaryNoClockError
 
 const char* NodeName(const ccomm_view* v, int node) {
   ccomm_peer_stats ps;
@@ -93,6 +94,8 @@ static int FillViewNode(const ccomm_view* v, int node, ccomm_view_node* out) {
   out->socket_drops = n.w[st::kVwSocketDrops];
   out->cycle_ms = static_cast<uint32_t>(n.w[st::kVwCycleMs]);
   out->summaries = n.w[st::kVwSummaries];
+  out->clock_state = static_cast<int32_t>(n.w[st::kVwClockState]);
+  out->clock_error_ns = n.w[st::kVwClockErrorNs] == kNoClockError ? -1 : static_cast<int64_t>(n.w[st::kVwClockErrorNs]);
   return 0;
 }
 

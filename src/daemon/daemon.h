@@ -183,6 +183,12 @@ class Daemon {
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
   SystemView view_;                        // node summaries: ccomm stats --all (system_view.h)
   ForeignFrameWatch foreign_;              // mismatched boards' frames (foreign_frames.h)
+  // Frames of another wire version (docs/protocol.md, Versioning): counted in frames_bad
+  // by the receive thread, which also notes the last one's version and sender here; the
+  // supervision tick logs them at most every 10 s (no syscall on the receive path).
+  std::atomic<uint64_t> other_version_frames_{0};
+  std::atomic<uint32_t> other_version_last_{0};  // version << 16 | sender
+  uint64_t other_version_logged_ = 0, other_version_next_log_ns_ = 0;
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};

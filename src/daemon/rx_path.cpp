@@ -172,8 +172,13 @@ __attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, cons
 void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
   wire::FrameHeader h;
   // One validation pass: entries of the signals this node takes cost one compare each.
-  if (wire::DecodeFrame(buf, len, &h, rx_known_.data(), rx_known_.size()) != wire::DecodeError::kOk) {
+  const wire::DecodeError decoded = wire::DecodeFrame(buf, len, &h, rx_known_.data(), rx_known_.size());
+  if (decoded != wire::DecodeError::kOk) {
     Count(store::kFramesBad);
+    if (decoded == wire::DecodeError::kBadVersion) {  // a board of another ccomm version: say so (supervision)
+      other_version_last_.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7], std::memory_order_relaxed);
+      other_version_frames_.store(other_version_frames_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    }
     return;
   }
   // Authenticate before any field is trusted (the decode above only checked bounds).

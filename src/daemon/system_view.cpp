@@ -159,6 +159,18 @@ uint32_t SystemView::Tick(uint64_t now) {
   head.frames_tx = sh->daemon_counters[store::kFramesTx].load(std::memory_order_relaxed);
   head.frames_bad = sh->daemon_counters[store::kFramesBad].load(std::memory_order_relaxed);
   head.socket_drops = sh->daemon_counters[store::kSocketDrops].load(std::memory_order_relaxed);
+  // This board's clock as the supervision tick published it (ptp_clock.cpp).
+  const store::PeerStats& me = segment_->peer(self_);
+  const uint64_t clock = me.clock_state.load(std::memory_order_acquire);
+  const auto state = static_cast<ptp::ClockState>(clock & 0xFF);
+  head.clock_state = static_cast<uint8_t>(clock & 0xFF) < wire::kSummaryClockStates ? static_cast<uint8_t>(clock & 0xFF) : 0;
+  const int64_t error = ptp::ClockErrorNs(state, static_cast<uint8_t>(clock >> 8),
+                                          static_cast<int64_t>(me.clock_offset_ns.load(std::memory_order_relaxed)),
+                                          static_cast<int64_t>(me.clock_path_delay_ns.load(std::memory_order_relaxed)));
+  head.clock_error_ns = error < 0 || error >= int64_t{wire::kSummaryNoClockError}
+                            ? wire::kSummaryNoClockError  // beyond 4.29 s is no bound worth the name
+                            : static_cast<uint32_t>(error);
+  head.clock_offset_ns = platform::RealtimeOffsetNs();
   const uint32_t first = part * static_cast<uint32_t>(wire::kSummaryMaxRecords);
   uint32_t end = first + static_cast<uint32_t>(wire::kSummaryMaxRecords);
   if (end > reported_.size()) end = static_cast<uint32_t>(reported_.size());
@@ -215,6 +227,12 @@ uint32_t SystemView::Tick(uint64_t now) {
   return sent;
 }
 
+void SystemView::SetClockWords(uint32_t node, const wire::SummaryHead& head) {
+  view_.SetNodeWord(node, store::kVwClockState, head.clock_state);
+  view_.SetNodeWord(node, store::kVwClockErrorNs, head.clock_error_ns);
+  view_.SetNodeWord(node, store::kVwClockOffsetNs, static_cast<uint64_t>(head.clock_offset_ns));
+}
+
 void SystemView::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now) {
   view_.BeginWrite(self_);
   view_.SetNodeWord(self_, store::kVwLastRxNs, now);
@@ -227,6 +245,7 @@ void SystemView::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32
   view_.SetNodeWord(self_, store::kVwFramesLost, head.frames_lost);
   view_.SetNodeWord(self_, store::kVwSocketDrops, head.socket_drops);
   view_.SetNodeWord(self_, store::kVwCycleMs, head.cycle_ms);
+  SetClockWords(self_, head);
   for (uint32_t i = first; i < end; ++i) {
     const wire::SummaryRecord& r = reported_[i].rec;
     view_.SetRow(self_, r.signal, r.role, r.flags, r.rate_mhz, r.lost, r.age_ms, now);
@@ -295,6 +314,7 @@ SystemView::Verdict SystemView::Receive(const uint8_t* frame, const wire::FrameH
   view_.SetNodeWord(node, store::kVwSocketDrops, head.socket_drops);
   view_.SetNodeWord(node, store::kVwCycleMs, head.cycle_ms);
   view_.SetNodeWord(node, store::kVwSummaries, parts_seen + 1);
+  SetClockWords(node, head);
   for (uint16_t i = 0; i < head.record_count; ++i) {
     wire::SummaryRecord r;
     wire::ReadSummaryRecord(frame, i, &r);

@@ -132,6 +132,9 @@ class ViewNode(ctypes.Structure):
         ("socket_drops", ctypes.c_uint64),
         ("cycle_ms", ctypes.c_uint32),
         ("summaries", ctypes.c_uint64),
+        ("clock_state", ctypes.c_int32),
+        ("reserved", ctypes.c_int32),
+        ("clock_error_ns", ctypes.c_int64),
     ]
 
 
@@ -310,6 +313,7 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_peer_clock_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_clock_state_sized": ([vp, vp, sz], c_int),
+        "ccomm_clock_state_name": ([c_int], cp),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
         "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),

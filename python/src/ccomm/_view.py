@@ -42,6 +42,8 @@ def system_view(handle: int) -> Dict[str, Any]:
                           "peers_alive": vn.peers_alive, "frames_rx": vn.frames_rx, "frames_tx": vn.frames_tx,
                           "frames_bad": vn.frames_bad, "frames_lost": vn.frames_lost,
                           "socket_drops": vn.socket_drops, "cycle_ms": vn.cycle_ms, "summaries": vn.summaries,
+                          "clock": {"state": L.ccomm_clock_state_name(vn.clock_state).decode(),
+                                    "error_ns": vn.clock_error_ns if vn.clock_error_ns >= 0 else None},
                           "signals": signals})
         for node in nodes:  # the bit mask as names, as the CLI prints it
             mask = node["peers_alive"]

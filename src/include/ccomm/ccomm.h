@@ -393,6 +393,10 @@ typedef struct ccomm_view_node {
   uint64_t socket_drops;
   uint32_t cycle_ms;       /**< its time to send its whole summary once */
   uint64_t summaries;      /**< summary parts of it applied here */
+  /* Its clock, as of that summary (docs/design.md, "Time"); fields added at the end. */
+  int32_t clock_state;     /**< ccomm_clock_state_code of that node */
+  int32_t reserved;        /**< 0 */
+  int64_t clock_error_ns;  /**< bound on its clock's offset from the PTP grandmaster; -1: none (not synced) */
 } ccomm_view_node;
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or node index, CCOMM_E_BUSY if the record
  *  was being rewritten throughout ~50 ms of waiting (ccommd stopped mid-rewrite). The view

@@ -39,20 +39,35 @@ def clocks_seen_from(pair, viewer):
     return {n["name"]: n["clock"] for n in view["nodes"] if n["reported"]}
 
 
+# A value from the control board, read on the planner once it arrived, and its production age.
+PY_AGE = ("import ccomm, json, sys, time\n"
+          "c = ccomm.Client(sys.argv[1])\n"
+          "deadline = time.monotonic() + 20\n"
+          "r = c.read('wheel0_pos')\n"
+          "while r.seq == 0 and time.monotonic() < deadline:\n"
+          "    time.sleep(0.05)\n"
+          "    r = c.read('wheel0_pos')\n"
+          "print(json.dumps({'seq': r.seq, 'age': c.production_age('wheel0_pos', r)}))\n")
+
 PY_VIEW = ("import ccomm, json, sys\n"
            "c = ccomm.Client(sys.argv[1])\n"
            "print(json.dumps({n['name']: n['clock'] for n in c.system_view()['nodes'] if n['reported']}))\n")
 
 
-def clocks_seen_from_python(pair, viewer):
-    """The same through the Python API (Client.system_view())."""
+def run_python(pair, node, program):
+    """`program` (printing one JSON line) through the Python API on `node`."""
     env = python_env(pair.env)
     env["CCOMM_LIBRARY"] = os.path.join(BUILD, "lib", "libccomm.so")
     env["PYTHONPATH"] = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python", "src")
-    out = subprocess.run(pair.exec_prefix(viewer) + [sys.executable, "-c", PY_VIEW, viewer], env=env,
+    out = subprocess.run(pair.exec_prefix(node) + [sys.executable, "-c", program, node], env=env,
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     return json.loads(out.stdout)
+
+
+def clocks_seen_from_python(pair, viewer):
+    """The same through the Python API (Client.system_view())."""
+    return run_python(pair, viewer, PY_VIEW)
 
 
 @pytest.mark.skipif(PTP4L is None, reason="needs linuxptp (ptp4l): scripts/setup core")
@@ -111,6 +126,13 @@ def test_clock_states_none_synced_syncing_lost():
             assert clocks_seen_from_python(pair, "planner")["control"] == gm
             table = pair.cli("planner", "stats", "--all").stdout
             assert "synced+-0ns" in table and "CLOCK" in table, table
+            # The planner's clock is not synced (free_running): a value that crossed the
+            # wire from the synced grandmaster has no production age, never a number.
+            pair.cli("control", "pub", "wheel0_pos", "1.5")
+            got = run_python(pair, "planner", PY_AGE)
+            assert got["seq"] > 0, got
+            if clock_state(pair, "planner")["state"] != "synced":
+                assert got["age"] == {"known": False, "code": "local_unsynced", "age_ns": None, "error_ns": None}, got
             # ptp4l killed: lost within its two missed polls (plus a loaded machine's delay).
             ptp["planner"].send_signal(signal.SIGKILL)
             ptp["planner"].wait()

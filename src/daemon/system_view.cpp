@@ -227,6 +227,18 @@ uint32_t SystemView::Tick(uint64_t now) {
   return sent;
 }
 
+bool SystemView::SyncedClockOffset(uint32_t node, uint64_t now, int64_t* offset_ns) const {
+  store::ViewNodeCopy n;
+  if (!view_.is_open() || node == self_ || !view_.ReadNode(node, &n)) return false;
+  const uint64_t last = n.w[store::kVwLastRxNs];
+  if (last == 0 || (now > last && now - last > n.w[store::kVwTimeoutNs])) return false;
+  if (n.w[store::kVwClockState] != static_cast<uint64_t>(ptp::ClockState::kSynced) ||
+      n.w[store::kVwClockErrorNs] == wire::kSummaryNoClockError)
+    return false;
+  *offset_ns = static_cast<int64_t>(n.w[store::kVwClockOffsetNs]);
+  return true;
+}
+
 void SystemView::SetClockWords(uint32_t node, const wire::SummaryHead& head) {
   view_.SetNodeWord(node, store::kVwClockState, head.clock_state);
   view_.SetNodeWord(node, store::kVwClockErrorNs, head.clock_error_ns);

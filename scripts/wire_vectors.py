@@ -18,8 +18,9 @@ import struct
 import sys
 
 MAGIC = 0x43434D57
-VERSION = 1
+VERSION = 2
 F_HEARTBEAT, F_AUTH, F_SUMMARY = 0x01, 0x02, 0x04
+CLOCK_STATES = {0: "none", 1: "syncing", 2: "synced", 3: "lost"}
 ROLES = {1: "producer", 2: "consumer"}
 E_EVENT, E_FRAGMENT = 0x01, 0x02
 
@@ -101,9 +102,11 @@ class Summary:
     """A node summary body (docs/protocol.md, "Node summary"): head, then records
     (signal, role, flags, rate_mhz, lost, age_ms); keyword overrides make bad ones."""
 
-    def __init__(self, part, parts, cycle_ms, uptime_ns, peers_alive, counters, records, **bad):
+    def __init__(self, part, parts, cycle_ms, uptime_ns, peers_alive, counters, records,
+                 clock=(0, 0xFFFFFFFF, 0), **bad):
         self.part, self.parts, self.cycle_ms, self.uptime_ns = part, parts, cycle_ms, uptime_ns
         self.peers_alive, self.counters, self.records, self.bad = peers_alive, counters, records, bad
+        self.clock = clock  # (clock_state, clock_error_ns, clock_offset_ns)
 
     def lines(self):
         n = self.bad.get("record_count", len(self.records))
@@ -116,6 +119,14 @@ class Summary:
             ([h("Q", rx), h("Q", tx)], "frames_rx %d, frames_tx %d" % (rx, tx)),
             ([h("Q", bad), h("Q", lost), h("Q", drops)], "frames_bad %d, frames_lost %d, socket_drops %d"
              % (bad, lost, drops)),
+        ]
+        state, error, offset = self.clock
+        reserved = self.bad.get("clock_reserved", 0)
+        out += [
+            ([h("B", state), h("B", reserved), h("H", 0), h("I", error)],
+             "clock_state %d (%s), reserved %#x, clock_error_ns %s"
+             % (state, CLOCK_STATES.get(state, "invalid"), reserved, "none" if error == 0xFFFFFFFF else error)),
+            ([h("q", offset)], "clock_offset_ns %d" % offset),
         ]
         for r in self.records:
             sig, role, flags, rate, lost_v, age = r[:6]
@@ -204,7 +215,9 @@ def vectors():
     sm = dict(sender=2, dest=0, config_hash=HASH, seq=3, time_ns=6000000000, flags=F_SUMMARY)
     counters = (12000, 11000, 1, 2, 0)
     recs = [(1, 1, 0x00, 1000000, 0, 1), (4, 2, 0x01, 0, 3, 250)]
-    summ = lambda records=recs, **bad: Summary(0, 1, 1000, 5000000000, 0x3, counters, records, **bad)
+    synced = (2, 12500, 1764000000123456789)  # a slave within 12.5 us; realtime - monotonic
+    summ = lambda records=recs, clock=synced, **bad: Summary(0, 1, 1000, 5000000000, 0x3, counters, records,
+                                                              clock=clock, **bad)
     return [
         # Valid frames (expect=ok). src/wire/wire_test_util.h (ValidVectors) encodes the same contents.
         Frame("heartbeat", "ok", note="(a) heartbeat from node 2 to every node", **hb),
@@ -221,8 +234,8 @@ def vectors():
               entries=[Entry(9, "int64", [-2], seq=10, time_ns=2000000000)], tag=TAG,
               note="(e) frame with an authentication tag (here 00..0f; the codec does not check it)"),
         Frame("summary", "ok", summary=summ(),
-              note="(f) node summary from node 2 to node 0: it produces signal 1 at 1000 values/s "
-                   "and consumes signal 4, which is stale", **sm),
+              note="(f) node summary from node 2 to node 0: its clock is synced (error bound 12.5 us), "
+                   "it produces signal 1 at 1000 values/s and consumes signal 4, which is stale", **sm),
         Frame("summary-empty-part", "ok", sender=5, dest=0xFFFF, config_hash=HASH, seq=0, time_ns=7000000000,
               flags=F_SUMMARY, summary=Summary(1, 2, 400, 9000000000, 0, (0, 0, 0, 0, 0), []),
               note="(g) part 1 of 2 without records, node 5 to every node"),
@@ -236,7 +249,7 @@ def vectors():
               time_ns=1100000000, flags=F_HEARTBEAT | F_AUTH,
               note="flag bit 1 announces a tag that is not there"),
         Frame("bad-magic", "bad_magic", magic=0x43434D58, note="magic \"CCMX\"", **hb),
-        Frame("bad-version", "bad_version", version=2, note="version 2", **hb),
+        Frame("bad-version", "bad_version", version=1, note="version 1 (before the clock in summaries)", **hb),
         Frame("unknown-frame-flag", "bad_header", sender=2, dest=0xFFFF, config_hash=HASH, seq=7,
               time_ns=1000000000, flags=F_HEARTBEAT | 0x08, note="frame flag bit 3 set"),
         Frame("summary-heartbeat", "bad_header", sender=2, dest=0xFFFF, config_hash=HASH, seq=7,
@@ -273,8 +286,8 @@ def vectors():
               note="the heartbeat plus one zero byte", **hb),
         Frame("summary-with-entry-count", "bad_header", summary=summ(), entry_count=1,
               note="a summary with entry_count 1 (its body is no entries)", **sm),
-        Frame("summary-short-body", "bad_summary", summary=summ(), payload_len=56, truncate=88,
-              note="a summary body of 56 bytes, shorter than its 64-byte head", **sm),
+        Frame("summary-short-body", "bad_summary", summary=summ(), payload_len=72, truncate=104,
+              note="a summary body of 72 bytes, shorter than its 80-byte head (a version-1 head and one record would be 88)", **sm),
         Frame("summary-part-out-of-range", "bad_summary", sender=2, dest=0, config_hash=HASH, seq=3,
               time_ns=6000000000, flags=F_SUMMARY, summary=Summary(1, 1, 1000, 5000000000, 0x3, counters, recs),
               note="part 1 of 1 (parts are numbered from 0)"),
@@ -286,6 +299,10 @@ def vectors():
               note="record flag bit 2 set", **sm),
         Frame("summary-not-increasing", "bad_summary", summary=summ([recs[1], recs[0]]),
               note="records not in increasing signal order (4, then 1)", **sm),
+        Frame("summary-clock-state", "bad_summary", summary=summ(clock=(4, 0xFFFFFFFF, 0)),
+              note="a summary whose clock_state is 4 (0-3 are defined)", **sm),
+        Frame("summary-clock-reserved", "bad_summary", summary=summ(clock_reserved=1),
+              note="a summary whose clock reserved byte is not 0", **sm),
         Frame("summary-record-reserved", "bad_summary", summary=summ([(1, 1, 0, 0, 0, 1, 1)]),
               note="record reserved field 1", **sm),
     ]
@@ -376,7 +393,7 @@ def main():
                      flags=F_SUMMARY | F_AUTH, tag=TAG,
                      summary=Summary(0, 2, 1000, 1, 0x7, (1, 2, 3, 4, 5),
                                      [(i, 1 + i % 2, i % 4, i, i, i) for i in range(56)])).data()
-        assert len(full) == 32 + 64 + 56 * 24 + 16
+        assert len(full) == 32 + 80 + 56 * 24 + 16
         seeds += [("max-frame", big), ("eth-padded-heartbeat", vs[0].data().ljust(46, b"\0")),
                   ("max-summary", full)]
         os.makedirs(args.corpus, exist_ok=True)

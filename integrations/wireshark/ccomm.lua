@@ -1,5 +1,5 @@
 -- SPDX-License-Identifier: Apache-2.0
--- Wireshark dissector for ccomm frames (wire format v1, docs/protocol.md), on raw
+-- Wireshark dissector for ccomm frames (wire format v2, docs/protocol.md), on raw
 -- Ethernet (EtherType 0x88B5) and UDP (port 47800, plus a heuristic for other ports).
 --
 --   tshark -X lua_script:ccomm.lua -r capture.pcap -O ccomm
@@ -21,9 +21,9 @@ local ccomm = Proto("ccomm", "ccomm signal frames")
 
 local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16
 local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46
-local MAGIC, VERSION = 0x43434D57, 1
+local MAGIC, VERSION = 0x43434D57, 2
 local F_HEARTBEAT, F_AUTH, F_SUMMARY, F_KNOWN = 0x01, 0x02, 0x04, 0x07
-local S_HEAD, S_RECORD, S_MAX = 64, 24, 56  -- node summary body (protocol.md "Node summary")
+local S_HEAD, S_RECORD, S_MAX = 80, 24, 56  -- node summary body (protocol.md "Node summary")
 local E_EVENT, E_FRAGMENT, E_KNOWN = 0x01, 0x02, 0x03
 local FRAGMENT_HEADER, MAX_FRAGMENTED = 8, 65536  -- fragment sub-header; largest fragmented value
 local DEST_ALL = 0xFFFF
@@ -103,6 +103,11 @@ local f = {
   s_frames_bad = ProtoField.uint64("ccomm.summary.frames_bad", "frames_bad", base.DEC),
   s_frames_lost = ProtoField.uint64("ccomm.summary.frames_lost", "frames_lost", base.DEC),
   s_socket_drops = ProtoField.uint64("ccomm.summary.socket_drops", "socket_drops", base.DEC),
+  s_clock_state = ProtoField.uint8("ccomm.summary.clock_state", "clock_state", base.DEC,
+    { [0] = "none", [1] = "syncing", [2] = "synced", [3] = "lost" }),
+  s_clock_reserved = ProtoField.uint24("ccomm.summary.clock_reserved", "reserved", base.HEX),
+  s_clock_error_ns = ProtoField.uint32("ccomm.summary.clock_error_ns", "clock_error_ns", base.DEC),
+  s_clock_offset_ns = ProtoField.int64("ccomm.summary.clock_offset_ns", "clock_offset_ns (realtime - monotonic)", base.DEC),
   r_record = ProtoField.none("ccomm.summary.record", "record"),
   r_signal = ProtoField.uint16("ccomm.summary.record.signal", "signal", base.DEC),
   r_role = ProtoField.uint8("ccomm.summary.record.role", "role", base.DEC, { [1] = "producer", [2] = "consumer" }),
@@ -360,18 +365,22 @@ end
 -- A node summary's body (SummaryBodyValid): head, then records, within what was captured.
 local S_HEAD_FIELDS = { { "s_part", 0, 1 }, { "s_parts", 1, 1 }, { "s_record_count", 2, 2 }, { "s_cycle_ms", 4, 4 },
   { "s_uptime_ns", 8, 8 }, { "s_peers_alive", 16, 8 }, { "s_frames_rx", 24, 8 }, { "s_frames_tx", 32, 8 },
-  { "s_frames_bad", 40, 8 }, { "s_frames_lost", 48, 8 }, { "s_socket_drops", 56, 8 } }
+  { "s_frames_bad", 40, 8 }, { "s_frames_lost", 48, 8 }, { "s_socket_drops", 56, 8 }, { "s_clock_state", 64, 1 },
+  { "s_clock_reserved", 65, 3 }, { "s_clock_error_ns", 68, 4 }, { "s_clock_offset_ns", 72, 8 } }
 local function dissect_summary(ctx, tvb, len, avail)
   local function bad(item, text) problem(ctx, item, "bad_summary", text) end
   local body = ctx.root:add(f.s_body, tvb(HEADER, math.max(0, math.min(len, avail - HEADER))))
-  if len < S_HEAD then return bad(body, string.format("body shorter than its 64-byte head (%d bytes)", len)) end
+  if len < S_HEAD then return bad(body, string.format("body shorter than its 80-byte head (%d bytes)", len)) end
   if avail < HEADER + S_HEAD then return end  -- not all there: too_short already says so
   for _, x in ipairs(S_HEAD_FIELDS) do body:add(f[x[1]], tvb(HEADER + x[2], x[3])) end
   local part, parts, n = tvb(HEADER, 1):uint(), tvb(HEADER + 1, 1):uint(), tvb(HEADER + 2, 2):uint()
   ctx.summary_text = string.format(", part %d/%d, %d record%s", part, parts, n, n == 1 and "" or "s")
   if parts == 0 or part >= parts then bad(body, string.format("part not below parts (%d, %d)", part, parts)) end
   if n > S_MAX then bad(body, string.format("record_count above 56 (%d)", n)) end
-  if len ~= S_HEAD + n * S_RECORD then bad(body, string.format("payload_len not 64 + 24 x record_count (%d)", len)) end
+  local clock_state = tvb(HEADER + 64, 1):uint()
+  if clock_state > 3 then bad(body, string.format("unknown clock_state (%d)", clock_state)) end
+  if tvb(HEADER + 65, 3):uint() ~= 0 then bad(body, "clock reserved bytes not 0") end
+  if len ~= S_HEAD + n * S_RECORD then bad(body, string.format("payload_len not 80 + 24 x record_count (%d)", len)) end
   local last, off = -1, HEADER + S_HEAD
   for i = 0, n - 1 do
     if off + S_RECORD > HEADER + len or off + S_RECORD > avail then break end
@@ -487,7 +496,7 @@ local function dissect(tvb, pinfo, tree)
     return finish(summary)
   end
   if version ~= VERSION then
-    problem(ctx, version_item, "bad_version", string.format("wrong version %d (this dissector knows version 1)", version))
+    problem(ctx, version_item, "bad_version", string.format("wrong version %d (this dissector knows version 2)", version))
     return finish(summary)
   end
 
@@ -557,7 +566,7 @@ function ccomm.dissector(tvb, pinfo, tree)
   return dissect(tvb, pinfo, tree)
 end
 
--- UDP on another port than the preference: frames that start with magic and version 1.
+-- UDP on another port than the preference: frames that start with magic and VERSION.
 local function heuristic(tvb, pinfo, tree)
   if tvb:len() < 8 or tvb(0, 4):uint() ~= MAGIC or tvb(4, 1):uint() ~= VERSION then return false end
   dissect(tvb, pinfo, tree)

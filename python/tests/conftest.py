@@ -47,7 +47,7 @@ def node(build_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterator[
     cfg.write_text((HERE / "signals.xml").read_text().replace("UDP_PORT", str(40000 + pid % 20000)))
     log = open(cfg.parent / "ccommd.log", "w")
     proc = subprocess.Popen([str(build_dir / "bin" / "ccommd"), "--config", str(cfg), "--node", "pytest",
-                             "--no-rt", "--transport", "udp"], stdout=log, stderr=subprocess.STDOUT)
+                             "--no-rt", "--transport", "udp", "--ptp-socket", "none"], stdout=log, stderr=subprocess.STDOUT)
     import ccomm
 
     deadline = time.monotonic() + 10

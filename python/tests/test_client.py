@@ -222,9 +222,30 @@ def test_system_view(client: Client) -> None:
     nodes = {n["name"]: n for n in v["nodes"]}
     me, remote = nodes["pytest"], nodes["remote"]
     assert me["self"] and me["reported"] and me["alive"] and me["peers_alive"] == []
+    # No ptp4l answers this test's ccommd: its clock is "none", with no error bound.
+    assert me["clock"] == {"state": "none", "error_ns": None}
     assert not remote["reported"] and not remote["alive"] and remote["signals"] == []
     sigs = {s["name"]: s for s in me["signals"]}
     assert sigs["d"]["role"] == "producer" and sigs["remote_x"]["role"] == "consumer"
     assert sigs["remote_x"]["stale"] and sigs["remote_x"]["age_ms"] is None  # never received
     assert len(sigs) == 11  # every signal of the file is produced or consumed here
     assert v["summaries"]["tx"] >= 1  # sent to "remote" (nobody listens there)
+
+
+def test_production_age_never_exact_without_synced_clocks(client: Client) -> None:
+    # This test's ccommd has no ptp4l (--ptp-socket none): a value from another node has
+    # no production age, never a number; one produced here is exact on this node's clock.
+    client.write("d", 2.5)
+    r = client.read("d")
+    before = Client.now() - r.source_time_ns
+    a = client.production_age("d", r)
+    after = Client.now() - r.source_time_ns
+    assert a["known"] and a["code"] == "same_node" and a["error_ns"] == 0
+    assert before <= a["age_ns"] <= after
+    remote = client.read("remote_x")
+    assert client.production_age("remote_x", remote) == {"known": False, "code": "never", "age_ns": None,
+                                                          "error_ns": None}
+    # As if a value had arrived: still unknown, because this board's clock is not synced.
+    fake = ccomm.Reading(0.0, ccomm.Status.FRESH, 1, 1000, Client.now() - 1000, 0, False)
+    assert client.production_age("remote_x", fake) == {"known": False, "code": "local_unsynced", "age_ns": None,
+                                                        "error_ns": None}

@@ -148,6 +148,10 @@ else:
         r = L.ccomm_view_get_node_sized(v, 0, p, size)
     elif name == "ccomm_view_signal":
         r = L.ccomm_view_get_signal_sized(v, 0, d, p, size)
+    elif name == "ccomm_production_age":
+        info = _native.Info()
+        assert L.ccomm_read(h, d, val, 8, ctypes.byref(info)) >= 0
+        r = L.ccomm_view_production_age_sized(v, d, ctypes.byref(info), p, size)
     else:
         r = L.ccomm_view_get_counters_sized(v, p, size)
 print("result", r)

@@ -37,6 +37,22 @@ std::string PeerNames(ccomm_client* c, uint64_t mask, bool json) {
   return out.empty() && !json ? "-" : out;
 }
 
+// A node's clock as one word: its state, and its error bound when it has one.
+std::string ClockText(const ccomm_view_node& vn) {
+  char buf[48];
+  if (vn.clock_error_ns < 0) snprintf(buf, sizeof buf, "%s", ccomm_clock_state_name(vn.clock_state));
+  else if (vn.clock_error_ns < 10000) snprintf(buf, sizeof buf, "%s+-%" PRId64 "ns", ccomm_clock_state_name(vn.clock_state), vn.clock_error_ns);
+  else snprintf(buf, sizeof buf, "%s+-%.0fus", ccomm_clock_state_name(vn.clock_state), static_cast<double>(vn.clock_error_ns) / 1e3);
+  return buf;
+}
+
+std::string ClockJson(const ccomm_view_node& vn) {
+  char buf[80];
+  if (vn.clock_error_ns < 0) snprintf(buf, sizeof buf, "{\"state\":\"%s\",\"error_ns\":null}", ccomm_clock_state_name(vn.clock_state));
+  else snprintf(buf, sizeof buf, "{\"state\":\"%s\",\"error_ns\":%" PRId64 "}", ccomm_clock_state_name(vn.clock_state), vn.clock_error_ns);
+  return buf;
+}
+
 void PrintJson(ccomm_client* c, ccomm_view* v) {
   ccomm_view_counters vc;
   ccomm_view_get_counters(v, &vc);
@@ -51,11 +67,11 @@ void PrintJson(ccomm_client* c, ccomm_view* v) {
     printf("%s{\"name\":\"%s\",\"self\":%s,\"reported\":%s,\"alive\":%s,\"age_ms\":%.1f,\"timeout_ms\":%.0f,"
            "\"uptime_s\":%.3f,\"peers_alive\":[%s],\"frames_rx\":%" PRIu64 ",\"frames_tx\":%" PRIu64
            ",\"frames_bad\":%" PRIu64 ",\"frames_lost\":%" PRIu64 ",\"socket_drops\":%" PRIu64
-           ",\"cycle_ms\":%u,\"summaries\":%" PRIu64 ",\"signals\":[",
+           ",\"cycle_ms\":%u,\"summaries\":%" PRIu64 ",\"clock\":%s,\"signals\":[",
            first_node ? "" : ",", Json(vn.name).c_str(), vn.is_self ? "true" : "false", vn.reported ? "true" : "false",
            vn.alive ? "true" : "false", Ms(vn.age_ns), Ms(vn.timeout_ns), static_cast<double>(vn.uptime_ns) / 1e9,
            PeerNames(c, vn.peers_alive, true).c_str(), vn.frames_rx, vn.frames_tx, vn.frames_bad, vn.frames_lost,
-           vn.socket_drops, vn.cycle_ms, vn.summaries);
+           vn.socket_drops, vn.cycle_ms, vn.summaries, ClockJson(vn).c_str());
     first_node = false;
     bool first = true;
     for (int s = 0; s < ccomm_signal_count(c); ++s) {
@@ -77,8 +93,8 @@ void PrintTable(ccomm_client* c, ccomm_view* v) {
   ccomm_view_get_counters(v, &vc);
   printf("system view from node %s (summaries every %u ms; tx=%" PRIu64 " rx=%" PRIu64 " refused=%" PRIu64 ")\n\n",
          ccomm_node_name(c), vc.summary_ms, vc.summaries_tx, vc.summaries_rx, vc.summaries_refused);
-  printf("%-12s %-5s %9s %10s %10s %10s %8s %8s  %s\n", "NODE", "ALIVE", "LAST_MS", "UPTIME_S", "FRAMES_RX",
-         "FRAMES_TX", "BAD", "LOST", "HEARS");
+  printf("%-12s %-5s %9s %10s %10s %10s %8s %8s %-18s %s\n", "NODE", "ALIVE", "LAST_MS", "UPTIME_S", "FRAMES_RX",
+         "FRAMES_TX", "BAD", "LOST", "CLOCK", "HEARS");
   for (int n = 0; n < ccomm_node_count(c); ++n) {
     ccomm_view_node vn;
     if (ccomm_view_get_node(v, n, &vn) != 0) continue;
@@ -87,9 +103,9 @@ void PrintTable(ccomm_client* c, ccomm_view* v) {
              "?", "-");
       continue;
     }
-    printf("%-12s %-5s %9.0f %10.1f %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %8" PRIu64 "  %s\n", vn.name,
+    printf("%-12s %-5s %9.0f %10.1f %10" PRIu64 " %10" PRIu64 " %8" PRIu64 " %8" PRIu64 " %-18s %s\n", vn.name,
            vn.alive ? "yes" : "NO", Ms(vn.age_ns), static_cast<double>(vn.uptime_ns) / 1e9, vn.frames_rx,
-           vn.frames_tx, vn.frames_bad, vn.frames_lost, PeerNames(c, vn.peers_alive, false).c_str());
+           vn.frames_tx, vn.frames_bad, vn.frames_lost, ClockText(vn).c_str(), PeerNames(c, vn.peers_alive, false).c_str());
   }
   printf("\n%-12s %-24s %-8s %10s %8s %-5s %10s\n", "NODE", "SIGNAL", "ROLE", "RATE/S", "LOST", "STALE", "AGE_MS");
   for (int n = 0; n < ccomm_node_count(c); ++n) {

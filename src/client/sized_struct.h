@@ -29,6 +29,7 @@ CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_view_signal, age_ns);
 CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_view_counters, summary_ms);
 CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_peer_clock, frames_delayed);
 CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_clock_state, path_delay_ns);
+CCOMM_FIRST_LAYOUT_ENDS_AT(ccomm_production_age, error_ns);
 #undef CCOMM_FIRST_LAYOUT_ENDS_AT
 
 // Copies `full` into the caller's `size` bytes at `out`: the first min(size, sizeof)

@@ -35,6 +35,13 @@ namespace platform {
 
 /// [rt] CLOCK_MONOTONIC in ns (vDSO, no syscall on Linux).
 uint64_t MonotonicNs();
+/// CLOCK_REALTIME in ns since 1970 (the clock ptp4l disciplines with software
+/// timestamping): the common time base between boards when their clocks are synced.
+uint64_t RealtimeNs();
+/// RealtimeNs() - MonotonicNs() now, read with the monotonic clock on both sides of the
+/// realtime one (their mean): what maps a monotonic stamp of this board to common time.
+/// It changes only when the realtime clock is stepped (both are slewed alike).
+int64_t RealtimeOffsetNs();
 
 /// [rt] Hint to the CPU inside a spin loop.
 inline void CpuRelax() {

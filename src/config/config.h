@@ -63,6 +63,11 @@ struct NodeConfig {
   int line = 0;                // line of <node> in the file, for messages
 };
 
+// stale_by="...": a consumer's age (and so fresh/stale) of a state counts from the value's
+// arrival on that board (default), or from its write on the producer when both boards'
+// clocks are synced (docs/design.md, "Time"; arrival again while they are not).
+enum class StaleBy : uint8_t { kArrival, kProduction };
+
 struct SignalConfig {
   std::string name;
   ValueType type = ValueType::kDouble;
@@ -71,6 +76,7 @@ struct SignalConfig {
   uint32_t producer = 0;       // node id
   std::vector<uint32_t> consumers;  // node ids
   uint32_t stale_after_ms = 0;  // 0 = never goes stale
+  StaleBy stale_by = StaleBy::kArrival;  // what a consumer's age counts from (local policy)
   bool has_safe_value = false;
   std::vector<uint8_t> safe_value;  // count * element size bytes, host byte order
   uint32_t period_us = 0;      // 0 = event-driven (sent on every write); >0 = sent every period,

@@ -139,6 +139,7 @@ std::string ConfigToJson(const SystemConfig& cfg) {
     for (uint32_t c : sig.consumers) consumers.push_back(cfg.nodes[c].name);
     Names(&o, "consumers", consumers);
     Num(&o, "stale_after_ms", sig.stale_after_ms);
+    Text(&o, "stale_by", sig.stale_by == StaleBy::kProduction ? "production" : "arrival");
     Num(&o, "period_us", sig.period_us);
     Num(&o, "queue_depth", sig.queue_depth);
     Bool(&o, "has_safe_value", sig.has_safe_value);

@@ -12,7 +12,7 @@ namespace config_detail {
 
 void Parser::SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs) {
   Element e(n, {"name", "type", "count", "kind", "producer", "consumers", "stale_after_ms",
-                "safe_value", "period_ms", "rate_hz", "queue_depth"},
+                "stale_by", "safe_value", "period_ms", "rate_hz", "queue_depth"},
             &diag_);
   sig->line = e.line();
   Name(e, "signal", &sig->name);
@@ -81,6 +81,14 @@ void Parser::SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs) {
     } else {
       sig->stale_after_ms = static_cast<uint32_t>(stale);
     }
+  }
+
+  if (const AttrValue* a = e.Get("stale_by")) {
+    if (a->value == "production") sig->stale_by = StaleBy::kProduction;
+    else if (a->value != "arrival")
+      Err(a->line, "unknown stale_by " + Quote(a->value) + " (expected arrival or production)");
+    if (is_event)
+      Err(a->line, "stale_by applies only to state signals (events are queued, never stale)");
   }
 
   const AttrValue* period = e.Get("period_ms");

@@ -199,6 +199,17 @@ void Daemon::Supervise(uint64_t now) {
       socket_drops_seen_ = drops;
     }
   }
+  const uint64_t other_version = other_version_frames_.load(std::memory_order_relaxed);
+  if (other_version != other_version_logged_ && now >= other_version_next_log_ns_) {
+    const uint32_t last = other_version_last_.load(std::memory_order_relaxed);
+    Log(LogLevel::kError,
+        "refused %llu frame(s) of wire version %u (the last from node id %u): this ccommd speaks version %u; "
+        "a board runs another ccomm version (counted in frames_bad, docs/protocol.md \"Versioning\")",
+        static_cast<unsigned long long>(other_version - other_version_logged_), last >> 16, last & 0xFFFF,
+        unsigned{wire::kVersion});
+    other_version_logged_ = other_version;
+    other_version_next_log_ns_ = now + 10000000000ull;
+  }
   if (const uint32_t foreign = foreign_.Poll(now))
     h->daemon_counters[store::kFramesForeign].fetch_add(foreign, std::memory_order_relaxed);
   for (uint32_t p = 0; p < peers_rx_.size(); ++p) {

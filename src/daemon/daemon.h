@@ -53,6 +53,12 @@ class Daemon {
   /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call every ~10 ms.
   void Supervise(uint64_t now_ns);
   void SuperviseClock(uint64_t now_ns);  // ptp_state.h, published in ptp_clock.cpp
+  /// What SuperviseClock hands the receive thread for stale_by="production": whether this
+  /// board's clock is synced, and its CLOCK_REALTIME - CLOCK_MONOTONIC (tests call it too).
+  void PublishSelfClock(bool synced, int64_t realtime_offset_ns) {
+    self_realtime_offset_ns_.store(realtime_offset_ns, std::memory_order_relaxed);
+    self_clock_synced_.store(synced ? 1 : 0, std::memory_order_release);
+  }
   void RequestStop();
   /// Detaches from the segment (which stays for the clients: their values go stale).
   void Shutdown();
@@ -115,6 +121,7 @@ class Daemon {
     bool one_word = false;      // one 8-byte element (double, int64): converted inline
     bool state_word = false;    // a one_word state: HandleFrame's inline path
     bool history = false;       // a history ring keeps its values (AppendHistory)
+    bool by_production = false; // stale_by="production": stamped with its write time when clocks allow
     SignalRx last;              // rule 6: its last applied value (receive thread only)
     store::SignalStats* stats = nullptr;
     store::StateView state;
@@ -183,6 +190,29 @@ class Daemon {
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)
   SystemViewWriter view_;                  // the system view: node summaries out and in (system_view_writer.h)
   ForeignFrameWatch foreign_;              // mismatched boards' frames (foreign_frames.h)
+  // Frames of another wire version (docs/protocol.md, Versioning): counted in frames_bad
+  // by the receive thread, which also notes the last one's version and sender here; the
+  // supervision tick logs them at most every 10 s (no syscall on the receive path).
+  // stale_by="production" (docs/design.md, "Time"): this board's clock as the supervision
+  // tick last saw it (synced, realtime - monotonic), for the receive thread; and, per
+  // frame on the receive thread, the map from the sender's monotonic clock onto ours
+  // through the common time base, valid only while both clocks are synced.
+  std::atomic<uint32_t> self_clock_synced_{0};
+  std::atomic<int64_t> self_realtime_offset_ns_{0};
+  bool any_by_production_ = false;
+  bool rx_production_map_ = false;
+  int64_t rx_production_map_ns_ = 0;
+  uint64_t ProductionStamp(uint64_t source_ns, uint64_t arrived) const {
+    if (!rx_production_map_) return arrived;  // a clock not synced: the arrival, as without the option
+    const int64_t mapped = static_cast<int64_t>(source_ns) + rx_production_map_ns_;
+    // Never later than the arrival: an age is never made younger than the local one.
+    return mapped <= 0 ? 1 : static_cast<uint64_t>(mapped) < arrived ? static_cast<uint64_t>(mapped) : arrived;
+  }
+  std::atomic<uint64_t> by_arrival_frames_{0};  // frames with such values judged by arrival (clocks)
+  uint64_t by_arrival_logged_ = 0, by_arrival_next_log_ns_ = 0;
+  std::atomic<uint64_t> other_version_frames_{0};
+  std::atomic<uint32_t> other_version_last_{0};  // version << 16 | sender
+  uint64_t other_version_logged_ = 0, other_version_next_log_ns_ = 0;
   std::vector<auth::ReplayWindow> replay_;  // per sender, used only with auth
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> tx_loops_{0}, rx_loops_{0};

@@ -43,6 +43,8 @@ void Daemon::PrepareRxTx() {
     r.one_word = d.count == 1 && d.value_bytes == 8;
     r.state_word = r.one_word && !is_event;
     r.history = history_[id].ring != nullptr;
+    r.by_production = !is_event && cfg_->signals[id].stale_by == StaleBy::kProduction;
+    any_by_production_ |= r.by_production;
     r.entry_size = static_cast<uint32_t>(wire::kEntryHeaderSize + ((d.value_bytes + 7u) & ~7u));
     if (is_event) r.ring = segment_.ring(id);
     else r.state = segment_.state(id);

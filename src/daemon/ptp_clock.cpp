@@ -3,6 +3,8 @@
 // ccomm_get_clock_state() and `ccomm stats` read it, and into the log when it changes.
 #include "daemon/daemon.h"
 
+#include "common/platform.h"
+
 namespace ccomm {
 
 void Daemon::SuperviseClock(uint64_t now) {
@@ -12,6 +14,15 @@ void Daemon::SuperviseClock(uint64_t now) {
   self.clock_offset_ns.store(static_cast<uint64_t>(ptp_.offset_ns()), std::memory_order_relaxed);
   self.clock_path_delay_ns.store(static_cast<uint64_t>(ptp_.path_delay_ns()), std::memory_order_relaxed);
   self.clock_state.store(word, std::memory_order_release);
+  PublishSelfClock(ptp_.state() == ptp::ClockState::kSynced, platform::RealtimeOffsetNs());
+  const uint64_t by_arrival = by_arrival_frames_.load(std::memory_order_relaxed);
+  if (by_arrival != by_arrival_logged_ && now >= by_arrival_next_log_ns_) {
+    Log(LogLevel::kNotice, "%llu frame(s) with stale_by=\"production\" values judged by their arrival: this "
+        "board's clock (%s) or the sender's is not synced, or no current summary of the sender",
+        static_cast<unsigned long long>(by_arrival - by_arrival_logged_), ptp::ClockStateName(ptp_.state()));
+    by_arrival_logged_ = by_arrival;
+    by_arrival_next_log_ns_ = now + 10000000000ull;
+  }
   if (!changed) return;
   const char* name = ptp::ClockStateName(ptp_.state());
   switch (ptp_.state()) {

@@ -26,11 +26,26 @@ namespace ptp {
 enum class ClockState : uint32_t { kNone = 0, kSyncing = 1, kSynced = 2, kLost = 3 };
 const char* ClockStateName(ClockState s);
 
+// A bound on this clock's offset from the grandmaster, in ns, or -1 when there is none
+// (not synced): 0 for the grandmaster itself; for a synced slave ptp4l's own estimate,
+// |offset from master| plus its mean path delay (a path's asymmetry shifts the offset by at
+// most half the round trip; with E2E the delay is not asked for and counts as 0).
+inline int64_t ClockErrorNs(ClockState state, uint8_t port_state, int64_t offset_ns, int64_t path_delay_ns);
+
 // IEEE 1588 port states (portState of PORT_DATA_SET).
 enum PortState : uint8_t {
   kPortUnknown = 0, kPortInitializing = 1, kPortFaulty = 2, kPortDisabled = 3, kPortListening = 4,
   kPortPreMaster = 5, kPortMaster = 6, kPortPassive = 7, kPortUncalibrated = 8, kPortSlave = 9,
 };
+
+inline int64_t ClockErrorNs(ClockState state, uint8_t port_state, int64_t offset_ns, int64_t path_delay_ns) {
+  if (state != ClockState::kSynced) return -1;
+  if (port_state != kPortSlave) return 0;  // synced and not a slave: the grandmaster
+  const uint64_t off = offset_ns < 0 ? 0 - static_cast<uint64_t>(offset_ns) : static_cast<uint64_t>(offset_ns);
+  const uint64_t delay = path_delay_ns < 0 ? 0 : static_cast<uint64_t>(path_delay_ns);
+  const uint64_t sum = off + delay;
+  return sum > uint64_t{INT64_MAX} ? INT64_MAX : static_cast<int64_t>(sum);
+}
 
 // Management ids asked for.
 constexpr uint16_t kIdPortDataSet = 0x2004;

@@ -152,6 +152,8 @@ __attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, cons
     if (value_seq == 0) return false;  // duplicate or older than what we have
   }
   const uint64_t source_ns = e.source_time_ns();
+  const uint64_t arrived = now;
+  if (rs.by_production) now = ProductionStamp(source_ns, arrived);  // the stamp ages count from
   const uint8_t* wire_value = entry + wire::kEntryHeaderSize;  // its prefix says: no fragment
   if (rs.state_word) {  // one double or int64 state (the common signal): inline
     const uint64_t word = wire::be::Load<uint64_t>(wire_value);
@@ -165,15 +167,20 @@ __attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, cons
   }
   store::SignalStats* const stats = rs.stats;
   stats->rx.store(stats->rx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  stats->last_rx_ns.store(now, std::memory_order_relaxed);
+  stats->last_rx_ns.store(arrived, std::memory_order_relaxed);
   return true;
 }
 
 void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
   wire::FrameHeader h;
   // One validation pass: entries of the signals this node takes cost one compare each.
-  if (wire::DecodeFrame(buf, len, &h, rx_known_.data(), rx_known_.size()) != wire::DecodeError::kOk) {
+  const wire::DecodeError decoded = wire::DecodeFrame(buf, len, &h, rx_known_.data(), rx_known_.size());
+  if (decoded != wire::DecodeError::kOk) {
     Count(store::kFramesBad);
+    if (decoded == wire::DecodeError::kBadVersion) {  // a board of another ccomm version: say so (supervision)
+      other_version_last_.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7], std::memory_order_relaxed);
+      other_version_frames_.store(other_version_frames_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    }
     return;
   }
   // Authenticate before any field is trusted (the decode above only checked bounds).
@@ -224,6 +231,14 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   // (peer_clock.h): a frame held seconds in our socket does not make its values fresh.
   const uint64_t arrived = now - ClampedQueueDelay(pr.clock.Observe(h.send_time_ns, now), now);
   AccountQueueDelay(ps, pr.clock, now - arrived);
+  if (any_by_production_) {  // the sender's clock onto ours, through the common time base
+    int64_t sender_offset = 0;
+    rx_production_map_ = self_clock_synced_.load(std::memory_order_acquire) != 0 &&
+                         view_.SyncedClockOffset(h.sender, now, &sender_offset);
+    rx_production_map_ns_ = sender_offset - self_realtime_offset_ns_.load(std::memory_order_relaxed);
+    if (!rx_production_map_)
+      by_arrival_frames_.store(by_arrival_frames_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
   if (!ps.alive.exchange(1, std::memory_order_acq_rel))
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
   if (h.flags & wire::kFlagHeartbeat) ps.heartbeats_rx.fetch_add(1, std::memory_order_relaxed);

@@ -56,6 +56,7 @@ class RxRulesTest : public testing::ReceivingDaemonTest {
     }
     size_t len = w.Finish();
     ASSERT_GT(len, 0u);
+    if (version_ != 0) buf[4] = version_;  // a board of another wire version
     ASSERT_EQ(sendto(fd >= 0 ? fd : tx_, buf.data(), len, 0, reinterpret_cast<const sockaddr*>(&to_), sizeof to_),
               static_cast<ssize_t>(len));
     ++sent_;
@@ -83,7 +84,26 @@ class RxRulesTest : public testing::ReceivingDaemonTest {
   }
 
   uint64_t sent_ = 0;
+  uint8_t version_ = 0;  // non-zero: Send writes this wire version instead of ours
 };
+
+TEST_F(RxRulesTest, FrameOfAnotherWireVersionIsCountedAndChangesNothing) {
+  // docs/protocol.md, Versioning: a version-1 frame (a board from before the clock in
+  // summaries) is refused as bad_version, counted in frames_bad, its value never stored.
+  ASSERT_EQ(wire::kVersion, 2);
+  version_ = 1;
+  Send(1, 0, kStateId, 1, 7.0);
+  WaitHandled();
+  EXPECT_EQ(Counter(store::kFramesBad), 1u);
+  EXPECT_EQ(Counter(store::kFramesRx), 0u);
+  EXPECT_EQ(Stats(kStateId).rx.load(), 0u);
+  version_ = 0;
+  Send(2, 0, kStateId, 2, 8.0);
+  WaitHandled();
+  uint64_t seq = 0;
+  EXPECT_EQ(State(&seq), 8.0);
+  EXPECT_EQ(Counter(store::kFramesBad), 1u);
+}
 
 TEST_F(RxRulesTest, StateAndFrameSequencesCrossTheWrap) {
   // Frame and value sequences both cross 0xFFFFFFFF: every value is applied, nothing

@@ -158,6 +158,18 @@ uint32_t SystemViewWriter::Tick(uint64_t now) {
   head.frames_tx = sh->daemon_counters[store::kFramesTx].load(std::memory_order_relaxed);
   head.frames_bad = sh->daemon_counters[store::kFramesBad].load(std::memory_order_relaxed);
   head.socket_drops = sh->daemon_counters[store::kSocketDrops].load(std::memory_order_relaxed);
+  // This board's clock as the supervision tick published it (ptp_clock.cpp).
+  const store::PeerStats& me = segment_->peer(self_);
+  const uint64_t clock = me.clock_state.load(std::memory_order_acquire);
+  const auto state = static_cast<ptp::ClockState>(clock & 0xFF);
+  head.clock_state = static_cast<uint8_t>(clock & 0xFF) < wire::kSummaryClockStates ? static_cast<uint8_t>(clock & 0xFF) : 0;
+  const int64_t error = ptp::ClockErrorNs(state, static_cast<uint8_t>(clock >> 8),
+                                          static_cast<int64_t>(me.clock_offset_ns.load(std::memory_order_relaxed)),
+                                          static_cast<int64_t>(me.clock_path_delay_ns.load(std::memory_order_relaxed)));
+  head.clock_error_ns = error < 0 || error >= int64_t{wire::kSummaryNoClockError}
+                            ? wire::kSummaryNoClockError  // beyond 4.29 s is no bound worth the name
+                            : static_cast<uint32_t>(error);
+  head.clock_offset_ns = platform::RealtimeOffsetNs();
   const uint32_t first = part * static_cast<uint32_t>(wire::kSummaryMaxRecords);
   uint32_t end = first + static_cast<uint32_t>(wire::kSummaryMaxRecords);
   if (end > reported_.size()) end = static_cast<uint32_t>(reported_.size());
@@ -214,6 +226,24 @@ uint32_t SystemViewWriter::Tick(uint64_t now) {
   return sent;
 }
 
+bool SystemViewWriter::SyncedClockOffset(uint32_t node, uint64_t now, int64_t* offset_ns) const {
+  store::ViewNodeCopy n;
+  if (!view_.is_open() || node == self_ || !view_.ReadNode(node, &n)) return false;
+  const uint64_t last = n.w[store::kVwLastRxNs];
+  if (last == 0 || (now > last && now - last > n.w[store::kVwTimeoutNs])) return false;
+  if (n.w[store::kVwClockState] != static_cast<uint64_t>(ptp::ClockState::kSynced) ||
+      n.w[store::kVwClockErrorNs] == wire::kSummaryNoClockError)
+    return false;
+  *offset_ns = static_cast<int64_t>(n.w[store::kVwClockOffsetNs]);
+  return true;
+}
+
+void SystemViewWriter::SetClockWords(uint32_t node, const wire::SummaryHead& head) {
+  view_.SetNodeWord(node, store::kVwClockState, head.clock_state);
+  view_.SetNodeWord(node, store::kVwClockErrorNs, head.clock_error_ns);
+  view_.SetNodeWord(node, store::kVwClockOffsetNs, static_cast<uint64_t>(head.clock_offset_ns));
+}
+
 void SystemViewWriter::WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now) {
   view_.BeginWrite(self_);
   view_.SetNodeWord(self_, store::kVwLastRxNs, now);
@@ -226,6 +256,7 @@ void SystemViewWriter::WriteSelf(const wire::SummaryHead& head, uint32_t first, 
   view_.SetNodeWord(self_, store::kVwFramesLost, head.frames_lost);
   view_.SetNodeWord(self_, store::kVwSocketDrops, head.socket_drops);
   view_.SetNodeWord(self_, store::kVwCycleMs, head.cycle_ms);
+  SetClockWords(self_, head);
   for (uint32_t i = first; i < end; ++i) {
     const wire::SummaryRecord& r = reported_[i].rec;
     view_.SetRow(self_, r.signal, r.role, r.flags, r.rate_mhz, r.lost, r.age_ms, now);
@@ -294,6 +325,7 @@ SystemViewWriter::Verdict SystemViewWriter::Receive(const uint8_t* frame, const 
   view_.SetNodeWord(node, store::kVwSocketDrops, head.socket_drops);
   view_.SetNodeWord(node, store::kVwCycleMs, head.cycle_ms);
   view_.SetNodeWord(node, store::kVwSummaries, parts_seen + 1);
+  SetClockWords(node, head);
   for (uint16_t i = 0; i < head.record_count; ++i) {
     wire::SummaryRecord r;
     wire::ReadSummaryRecord(frame, i, &r);

@@ -46,6 +46,11 @@ class SystemViewWriter {
   /// A frame DecodeHeader accepted with kFlagSummary, after authentication.
   Verdict Receive(const uint8_t* frame, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from);
 
+  /// Receive thread (it writes other nodes' records): true, with `node`'s CLOCK_REALTIME -
+  /// CLOCK_MONOTONIC, if its newest summary is current (within its timeout at `now`) and
+  /// says its clock is synced.
+  bool SyncedClockOffset(uint32_t node, uint64_t now, int64_t* offset_ns) const;
+
   /// Time between two parts and the number of parts (0 if summaries are off).
   uint64_t interval_ns() const { return interval_ns_; }
   uint32_t parts() const { return parts_; }
@@ -72,6 +77,7 @@ class SystemViewWriter {
 
   void Snapshot(uint64_t now);
   void SendPart(uint32_t part, uint64_t now);
+  void SetClockWords(uint32_t node, const wire::SummaryHead& head);  // inside Begin/EndWrite
   void WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now);
 
   const SystemConfig* cfg_ = nullptr;

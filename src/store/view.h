@@ -24,7 +24,7 @@ namespace ccomm {
 namespace store {
 
 constexpr uint32_t kViewMagic = 0x43435657;  // "CCVW"
-constexpr uint32_t kViewVersion = 1;
+constexpr uint32_t kViewVersion = 2;  // 2: node clock words
 enum ViewState : uint32_t { kViewInitializing = 0, kViewReady = 1 };
 
 struct ViewHeader {
@@ -49,6 +49,9 @@ enum ViewNodeWord : uint32_t {
   kVwFramesRx, kVwFramesTx, kVwFramesBad, kVwFramesLost, kVwSocketDrops,
   kVwCycleMs,        // its time to send all parts of its summary
   kVwSummaries,      // summary parts applied
+  kVwClockState,     // its ptp::ClockState (wire::SummaryHead::clock_state)
+  kVwClockErrorNs,   // bound on its clock's offset from the grandmaster, wire::kSummaryNoClockError: none
+  kVwClockOffsetNs,  // int64: its CLOCK_REALTIME - CLOCK_MONOTONIC, as of that summary
   kVwNodeWords
 };
 

@@ -15,7 +15,8 @@ using be::Store;
 
 // Head offsets (from the start of the payload).
 constexpr size_t kOffPart = 0, kOffParts = 1, kOffRecords = 2, kOffCycle = 4, kOffUptime = 8,
-                 kOffPeers = 16, kOffRx = 24, kOffTx = 32, kOffBad = 40, kOffLost = 48, kOffDrops = 56;
+                 kOffPeers = 16, kOffRx = 24, kOffTx = 32, kOffBad = 40, kOffLost = 48, kOffDrops = 56,
+                 kOffClockState = 64, kOffClockReserved = 65, kOffClockError = 68, kOffClockOffset = 72;
 // Record offsets.
 constexpr size_t kROffSignal = 0, kROffRole = 2, kROffFlags = 3, kROffRate = 4, kROffLost = 8,
                  kROffAge = 16, kROffReserved = 20;
@@ -30,6 +31,9 @@ bool SummaryBodyValid(const uint8_t* body, size_t len) {
   const uint8_t part = body[kOffPart], parts = body[kOffParts];
   const uint16_t n = Load<uint16_t>(body + kOffRecords);
   if (parts == 0 || part >= parts || n > kSummaryMaxRecords) return false;
+  if (body[kOffClockState] >= kSummaryClockStates || body[kOffClockReserved] != 0 || body[kOffClockReserved + 1] != 0 ||
+      body[kOffClockReserved + 2] != 0)
+    return false;
   if (len != kSummaryHeadSize + size_t{n} * kSummaryRecordSize) return false;
   int32_t last = -1;
   for (uint16_t i = 0; i < n; ++i) {
@@ -56,6 +60,9 @@ void ReadSummaryHead(const uint8_t* frame, SummaryHead* h) {
   h->frames_bad = Load<uint64_t>(b + kOffBad);
   h->frames_lost = Load<uint64_t>(b + kOffLost);
   h->socket_drops = Load<uint64_t>(b + kOffDrops);
+  h->clock_state = b[kOffClockState];
+  h->clock_error_ns = Load<uint32_t>(b + kOffClockError);
+  h->clock_offset_ns = static_cast<int64_t>(Load<uint64_t>(b + kOffClockOffset));
 }
 
 void ReadSummaryRecord(const uint8_t* frame, uint16_t i, SummaryRecord* r) {
@@ -72,7 +79,9 @@ bool SummaryWriter::Begin(const FrameHeader& h, const SummaryHead& head) {
   count_ = 0;
   last_signal_ = -1;
   head_ = nullptr;
-  if (!(h.flags & kFlagSummary) || head.parts == 0 || head.part >= head.parts) return false;
+  if (!(h.flags & kFlagSummary) || head.parts == 0 || head.part >= head.parts ||
+      head.clock_state >= kSummaryClockStates)
+    return false;
   w_.Begin(h);
   head_ = w_.ReserveBody(kSummaryHeadSize);
   if (head_ == nullptr) return false;
@@ -87,6 +96,10 @@ bool SummaryWriter::Begin(const FrameHeader& h, const SummaryHead& head) {
   Store<uint64_t>(head_ + kOffBad, head.frames_bad);
   Store<uint64_t>(head_ + kOffLost, head.frames_lost);
   Store<uint64_t>(head_ + kOffDrops, head.socket_drops);
+  head_[kOffClockState] = head.clock_state;
+  head_[kOffClockReserved] = head_[kOffClockReserved + 1] = head_[kOffClockReserved + 2] = 0;
+  Store<uint32_t>(head_ + kOffClockError, head.clock_error_ns);
+  Store<uint64_t>(head_ + kOffClockOffset, static_cast<uint64_t>(head.clock_offset_ns));
   return true;
 }
 

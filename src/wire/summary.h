@@ -15,10 +15,13 @@
 namespace ccomm {
 namespace wire {
 
-constexpr size_t kSummaryHeadSize = 64;
+constexpr size_t kSummaryHeadSize = 80;
 constexpr size_t kSummaryRecordSize = 24;
-/// Records per part, with room for an authentication tag: (1472 - 16 - 32 - 64) / 24.
+/// Records per part, with room for an authentication tag: (1472 - 16 - 32 - 80) / 24.
 constexpr size_t kSummaryMaxRecords = 56;
+static_assert(kHeaderSize + kSummaryHeadSize + kSummaryMaxRecords * kSummaryRecordSize + kAuthTagSize <= kMaxFrameSize,
+              "a full summary part with a tag fits a frame");
+constexpr uint32_t kSummaryNoClockError = 0xFFFFFFFFu;  // clock_error_ns: no bound (not synced)
 constexpr uint32_t kSummaryNoAge = 0xFFFFFFFFu;  // age_ms of a signal never received/written
 
 enum SummaryRole : uint8_t { kRoleProduced = 1, kRoleConsumed = 2 };
@@ -38,7 +41,15 @@ struct SummaryHead {
   uint64_t frames_rx = 0, frames_tx = 0, frames_bad = 0;
   uint64_t frames_lost = 0;   // sum over its peers of their frame sequence gaps
   uint64_t socket_drops = 0;
+  // The sender's clock (wire v2): its ptp::ClockState (0 none, 1 syncing, 2 synced, 3 lost),
+  // a bound on its offset from the grandmaster (kSummaryNoClockError: none), and its
+  // CLOCK_REALTIME minus CLOCK_MONOTONIC when it sent the part (maps its source_time_ns,
+  // monotonic, to the common time base).
+  uint8_t clock_state = 0;
+  uint32_t clock_error_ns = kSummaryNoClockError;
+  int64_t clock_offset_ns = 0;
 };
+constexpr uint8_t kSummaryClockStates = 4;  // clock_state values 0..3; others are invalid
 
 struct SummaryRecord {
   uint16_t signal = 0;

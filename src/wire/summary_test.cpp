@@ -87,6 +87,9 @@ std::map<std::string, SummaryDef> ValidSummaries() {
   a.frames_bad = 1;
   a.frames_lost = 2;
   a.socket_drops = 0;
+  a.clock_state = 2;  // synced
+  a.clock_error_ns = 12500;
+  a.clock_offset_ns = 1764000000123456789;
   v["summary"] = {SummaryHeader(2, 0, 3, 6000000000), a,
                   {{1, kRoleProduced, 0, 1000000, 0, 1}, {4, kRoleConsumed, kRecordStale, 0, 3, 250}}};
   SummaryHead b;
@@ -138,6 +141,9 @@ TEST(SummaryVectors, MatchEncoderAndDecoder) {
     EXPECT_EQ(head.frames_bad, v.second.head.frames_bad);
     EXPECT_EQ(head.frames_lost, v.second.head.frames_lost);
     EXPECT_EQ(head.socket_drops, v.second.head.socket_drops);
+    EXPECT_EQ(head.clock_state, v.second.head.clock_state);
+    EXPECT_EQ(head.clock_error_ns, v.second.head.clock_error_ns);
+    EXPECT_EQ(head.clock_offset_ns, v.second.head.clock_offset_ns);
     for (uint16_t i = 0; i < head.record_count; ++i) {
       SummaryRecord r;
       ReadSummaryRecord(it->second.second.data(), i, &r);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// ccomm wire format v1 codec (layout in docs/protocol.md).
+// ccomm wire format v2 codec (layout in docs/protocol.md).
 //
 // Every multi-byte field is read and written with memcpy plus an explicit byte swap, so
 // the code has no alignment requirement and no type-punning UB on any target. Every
@@ -158,7 +158,7 @@ void FrameWriter::Begin(const FrameHeader& h) {
   limit_ = cap_ < max ? cap_ : max;
   if (h.flags & kFlagHeartbeat) limit_ = kHeaderSize;  // heartbeats carry no entries: no room for one
   Store<uint32_t>(buf_ + kOffMagic, kMagic);
-  buf_[kOffVersion] = kVersion;  // this codec writes v1 only, whatever h.version says
+  buf_[kOffVersion] = kVersion;  // this codec writes kVersion only, whatever h.version says
   buf_[kOffFlags] = h.flags;
   Store<uint16_t>(buf_ + kOffSender, h.sender);
   Store<uint32_t>(buf_ + kOffHash, h.config_hash);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// ccomm wire format v1: fixed-width, network byte order. Specified in docs/protocol.md;
+// ccomm wire format v2: fixed-width, network byte order. Specified in docs/protocol.md;
 // the hex test vectors there are the ones wire_test.cpp checks.
 //
 // Encoding and decoding work on caller-provided buffers, never allocate and never read
@@ -17,7 +17,7 @@ namespace ccomm {
 namespace wire {
 
 constexpr uint32_t kMagic = 0x43434D57;  // "CCMW"
-constexpr uint8_t kVersion = 1;
+constexpr uint8_t kVersion = 2;  // 2: the node summary's head carries the sender's clock (summary.h)
 constexpr size_t kHeaderSize = 32;
 constexpr size_t kEntryHeaderSize = 24;
 constexpr size_t kAuthTagSize = 16;

@@ -42,7 +42,8 @@ TEST_F(Malformed, Header) {
   EXPECT_EQ(With(0, 0x44), DecodeError::kBadMagic);
   EXPECT_EQ(With(3, 0x57 ^ 0x80), DecodeError::kBadMagic);
   EXPECT_EQ(With(4, 0), DecodeError::kBadVersion);
-  EXPECT_EQ(With(4, 2), DecodeError::kBadVersion);
+  EXPECT_EQ(With(4, 1), DecodeError::kBadVersion);  // version 1: before the clock in summaries
+  EXPECT_EQ(With(4, 3), DecodeError::kBadVersion);
   for (int bit = 2; bit < 8; ++bit) EXPECT_EQ(With(5, 1u << bit), DecodeError::kBadHeader) << bit;
   for (size_t off = 30; off < 32; ++off) EXPECT_EQ(With(off, 1), DecodeError::kBadHeader) << off;
   // dest is any node id; which ones exist is the receiver's business.

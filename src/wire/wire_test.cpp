@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -324,3 +325,23 @@ TEST(Limits, AddRejectsInvalidArguments) {
 }  // namespace
 }  // namespace wire
 }  // namespace ccomm
+
+// Copies of the wire version outside the C++ codec (tools and tests that build or dissect
+// frames on their own) must follow kVersion: a stale copy would make its test send
+// frames every receiver refuses as bad_version, or the dissector flag every frame.
+TEST(WireVersion, EveryCopyFollowsKVersion) {
+  const std::string v = std::to_string(unsigned{ccomm::wire::kVersion});
+  const std::pair<const char*, std::string> copies[] = {
+      {"scripts/wire_vectors.py", "\nVERSION = " + v + "\n"},
+      {"integrations/wireshark/ccomm.lua", "local MAGIC, VERSION = 0x43434D57, " + v + "\n"},
+      {"tests/reliability/authframe.py", "MAGIC, VERSION, FLAG_HEARTBEAT, FLAG_AUTH = 0x43434D57, " + v + ","},
+      {"tests/reliability/flood.c", "f[4] = " + v + "; /* wire::kVersion"},
+      {"docs/protocol.md", "# ccomm wire protocol, version " + v + "\n"},
+  };
+  for (const auto& c : copies) {
+    std::ifstream in(std::string(CCOMM_SOURCE_DIR) + "/" + c.first, std::ios::binary);
+    ASSERT_TRUE(in.good()) << c.first;
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(c.second), std::string::npos) << c.first << " does not say wire version " << v;
+  }
+}

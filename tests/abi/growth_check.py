@@ -12,7 +12,8 @@ import sys
 import xml.etree.ElementTree as ET
 
 GROWABLE = {"ccomm_signal_desc", "ccomm_signal_stats", "ccomm_peer_stats", "ccomm_view_node",
-            "ccomm_view_signal", "ccomm_view_counters", "ccomm_peer_clock", "ccomm_clock_state"}
+            "ccomm_view_signal", "ccomm_view_counters", "ccomm_peer_clock", "ccomm_clock_state",
+            "ccomm_production_age"}
 FIXED = {"ccomm_info", "ccomm_history_cursor", "ccomm_history_info"}
 # Changes made before the rule, each with why old programs still work.
 EXCEPTIONS = {

@@ -10,7 +10,7 @@ import socket
 import struct
 import time
 
-MAGIC, VERSION, FLAG_HEARTBEAT, FLAG_AUTH = 0x43434D57, 1, 0x01, 0x02
+MAGIC, VERSION, FLAG_HEARTBEAT, FLAG_AUTH = 0x43434D57, 2, 0x01, 0x02
 
 
 def frame(sender, dest, config_hash, seq, send_ns, key, flip_tag=False):

@@ -68,7 +68,7 @@ def main():
     for i, fr in enumerate(frames):
         heuristic = i % 10 == 9  # another UDP port, a frame starting with the magic
         if heuristic:
-            fr = struct.pack(">IB", wire_vectors.MAGIC, 1) + fr[5:]
+            fr = struct.pack(">IB", wire_vectors.MAGIC, wire_vectors.VERSION) + fr[5:]
             packets.append(wslib.udp(fr, port=40000 + i % 1000))
         else:
             packets.append(wslib.udp(fr) if i % 2 else wslib.ethernet(fr))

@@ -37,7 +37,8 @@ FIELDS = ["ccomm.magic", "ccomm.version", "ccomm.flags", "ccomm.sender", "ccomm.
           "ccomm.summary.record_count", "ccomm.summary.cycle_ms", "ccomm.summary.uptime_ns",
           "ccomm.summary.frames_rx", "ccomm.summary.record.signal", "ccomm.summary.record.role",
           "ccomm.summary.record.flags", "ccomm.summary.record.rate_mhz", "ccomm.summary.record.lost",
-          "ccomm.summary.record.age_ms"] + \
+          "ccomm.summary.record.age_ms", "ccomm.summary.clock_state", "ccomm.summary.clock_error_ns",
+          "ccomm.summary.clock_offset_ns"] + \
          ["ccomm.entry.value." + t for t in TYPE_NAMES.values()]
 failures = []
 
@@ -64,7 +65,7 @@ def message_words(msg):
 def expected_frame(v):
     """What the dissector must show for a valid vector, from the encoder's inputs."""
     data = v.data()
-    exp = {"ccomm.magic": "0x43434d57", "ccomm.version": "1", "ccomm.flags": "0x%02x" % v.flags,
+    exp = {"ccomm.magic": "0x43434d57", "ccomm.version": str(wire_vectors.VERSION), "ccomm.flags": "0x%02x" % v.flags,
            "ccomm.sender": str(v.sender), "ccomm.config_hash": "0x%08x" % v.config_hash,
            "ccomm.seq": str(v.seq), "ccomm.send_time_ns": str(v.time_ns),
            "ccomm.entry_count": str(len(v.entries)), "ccomm.payload_len": str(len(data) - 32 - (16 if v.tag else 0)),
@@ -104,6 +105,9 @@ def check_valid(pkt, v, where):
                         ("ccomm.summary.cycle_ms", [str(sm.cycle_ms)]),
                         ("ccomm.summary.uptime_ns", [str(sm.uptime_ns)]),
                         ("ccomm.summary.frames_rx", [str(sm.counters[0])]),
+                        ("ccomm.summary.clock_state", [str(sm.clock[0])]),
+                        ("ccomm.summary.clock_error_ns", [str(sm.clock[1])]),
+                        ("ccomm.summary.clock_offset_ns", [str(sm.clock[2])]),
                         ("ccomm.summary.record.signal", [str(r[0]) for r in recs]),
                         ("ccomm.summary.record.role", [str(r[1]) for r in recs]),
                         ("ccomm.summary.record.flags", ["0x%02x" % r[2] for r in recs]),

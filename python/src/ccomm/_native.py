@@ -132,6 +132,9 @@ class ViewNode(ctypes.Structure):
         ("socket_drops", ctypes.c_uint64),
         ("cycle_ms", ctypes.c_uint32),
         ("summaries", ctypes.c_uint64),
+        ("clock_state", ctypes.c_int32),
+        ("reserved", ctypes.c_int32),
+        ("clock_error_ns", ctypes.c_int64),
     ]
 
 
@@ -159,6 +162,16 @@ class ViewCounters(ctypes.Structure):
     ]
 
 
+class ProductionAge(ctypes.Structure):
+    """ccomm_production_age."""
+    _fields_ = [
+        ("code", ctypes.c_int32),
+        ("known", ctypes.c_int32),
+        ("age_ns", ctypes.c_int64),
+        ("error_ns", ctypes.c_int64),
+    ]
+
+
 # The public structs of ccomm.h by their C name: what the layout test compares.
 STRUCTS: Dict[str, Type[ctypes.Structure]] = {
     "ccomm_info": Info, "ccomm_signal_desc": SignalDesc, "ccomm_history_cursor": HistoryCursor,
@@ -166,6 +179,7 @@ STRUCTS: Dict[str, Type[ctypes.Structure]] = {
     "ccomm_history_info": HistoryInfo, "ccomm_signal_stats": SignalStats,
     "ccomm_peer_stats": PeerStats, "ccomm_view_node": ViewNode,
     "ccomm_view_signal": ViewSignal, "ccomm_view_counters": ViewCounters,
+    "ccomm_production_age": ProductionAge,
 }
 
 _STRUCT_CODES: Dict[Any, str] = {ctypes.c_int32: "i", ctypes.c_uint32: "I", ctypes.c_int64: "q",
@@ -310,11 +324,13 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_peer_clock_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_clock_state_sized": ([vp, vp, sz], c_int),
+        "ccomm_clock_state_name": ([c_int], cp),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
         "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_view_get_signal_sized": ([vp, c_int, i32, vp, sz], c_int),
         "ccomm_view_get_counters_sized": ([vp, vp, sz], c_int),
+        "ccomm_view_production_age_sized": ([vp, i32, vp, vp, sz], c_int),
         "ccomm_history_depth": ([vp, i32], c_int),
         "ccomm_history_start": ([vp, i32, u32, vp], c_int),
         "ccomm_history_read": ([vp, i32, vp, vp, sz, vp], c_int),

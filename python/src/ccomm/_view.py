@@ -42,6 +42,8 @@ def system_view(handle: int) -> Dict[str, Any]:
                           "peers_alive": vn.peers_alive, "frames_rx": vn.frames_rx, "frames_tx": vn.frames_tx,
                           "frames_bad": vn.frames_bad, "frames_lost": vn.frames_lost,
                           "socket_drops": vn.socket_drops, "cycle_ms": vn.cycle_ms, "summaries": vn.summaries,
+                          "clock": {"state": L.ccomm_clock_state_name(vn.clock_state).decode(),
+                                    "error_ns": vn.clock_error_ns if vn.clock_error_ns >= 0 else None},
                           "signals": signals})
         for node in nodes:  # the bit mask as names, as the CLI prints it
             mask = node["peers_alive"]
@@ -50,5 +52,28 @@ def system_view(handle: int) -> Dict[str, Any]:
                 "summaries": {"tx": vc.summaries_tx, "rx": vc.summaries_rx, "refused": vc.summaries_refused,
                               "old": vc.summaries_old, "send_errors": vc.summaries_send_errors},
                 "nodes": nodes}
+    finally:
+        L.ccomm_view_close(v)
+
+
+# ccomm_production_age_code, by value.
+_AGE_CODES = {0: "synced", 1: "same_node", 2: "never", 3: "local_unsynced", 4: "producer_unsynced",
+              5: "no_summary"}
+
+
+def production_age(handle: int, signal_id: int, seq: int, source_time_ns: int) -> Dict[str, Any]:
+    """ccomm_view_production_age for the value a read returned (its seq and source time)."""
+    L = _native.lib()
+    v = ctypes.c_void_p()
+    _check(L.ccomm_view_open(handle, ctypes.byref(v)), "system view")
+    try:
+        info = _native.Info()
+        info.seq, info.source_time_ns = seq, source_time_ns
+        pa = _native.ProductionAge()
+        _check(L.ccomm_view_production_age_sized(v, signal_id, ctypes.byref(info), ctypes.byref(pa),
+                                                 ctypes.sizeof(pa)), "production age")
+        known = bool(pa.known)
+        return {"known": known, "code": _AGE_CODES.get(pa.code, str(pa.code)),
+                "age_ns": pa.age_ns if known else None, "error_ns": pa.error_ns if known else None}
     finally:
         L.ccomm_view_close(v)

@@ -421,6 +421,15 @@ class Client:
         """ccommd updated its heartbeat within the last second."""
         return bool(_native.lib().ccomm_daemon_alive(self._handle()))
 
+    def production_age(self, name: str, reading: Reading) -> Dict[str, Any]:
+        """How long ago the producer wrote the value `reading` (a read of signal `name`)
+        holds, on the boards' common (PTP) time base, as of now: {"known", "code",
+        "age_ns", "error_ns"}. known is False, age_ns and error_ns None, unless both
+        clocks are synced (code "synced": the age is within +/- error_ns) or the value was
+        produced on this node ("same_node": exact). docs/design.md, "Time"."""
+        sig = self.signal(name)
+        return _view.production_age(self._handle(), sig.info.id, reading.seq, reading.source_time_ns)
+
     def system_view(self) -> Dict[str, Any]:
         """Every node of the system as this board's ccommd knows it from the node
         summaries: the same dict as `ccomm stats --all --json` (nodes with alive, peers,

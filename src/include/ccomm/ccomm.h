@@ -109,7 +109,7 @@ CCOMM_API int ccomm_type_from_name(const char* name);
 
 /*
  * Growable structs. ccomm_signal_desc, ccomm_signal_stats, ccomm_peer_stats,
- * ccomm_peer_clock, ccomm_clock_state and the ccomm_view_* structs gain fields only at their end. The calls that fill them take the
+ * ccomm_peer_clock, ccomm_clock_state, ccomm_production_age and the ccomm_view_* structs gain fields only at their end. The calls that fill them take the
  * caller's sizeof (the *_sized entry points; the plain names below are macros passing
  * sizeof(*out)): the library fills that many bytes and zeroes any it has no field for, so
  * a program keeps working against a newer library (and a newer one against an older).
@@ -393,7 +393,44 @@ typedef struct ccomm_view_node {
   uint64_t socket_drops;
   uint32_t cycle_ms;       /**< its time to send its whole summary once */
   uint64_t summaries;      /**< summary parts of it applied here */
+  /* Its clock, as of that summary (docs/design.md, "Time"); fields added at the end. */
+  int32_t clock_state;     /**< ccomm_clock_state_code of that node */
+  int32_t reserved;        /**< 0 */
+  int64_t clock_error_ns;  /**< bound on its clock's offset from the PTP grandmaster; -1: none (not synced) */
 } ccomm_view_node;
+/**
+ * Production age: how long ago the producer wrote a value, on the common time base of the
+ * boards' PTP-synchronised clocks, with a bound on its error (docs/design.md, "Time").
+ * ccomm_info.age_ns is local (since the value reached this node); this is end to end.
+ */
+typedef enum ccomm_production_age_code {
+  CCOMM_PAGE_SYNCED = 0,        /**< both clocks synced: age_ns is within +/- error_ns */
+  CCOMM_PAGE_SAME_NODE = 1,     /**< produced on this node: one clock, age_ns exact (error_ns 0) */
+  CCOMM_PAGE_NEVER = 2,         /**< the read returned no value (info seq 0): unknown */
+  CCOMM_PAGE_LOCAL_UNSYNCED = 3,/**< this board's clock is not synced: unknown */
+  CCOMM_PAGE_PRODUCER_UNSYNCED = 4, /**< the producer's clock is not synced: unknown */
+  CCOMM_PAGE_NO_SUMMARY = 5     /**< no current summary of the producer (summary_ms 0, not heard,
+                                     busy record): its clock is unknown, so is the age */
+} ccomm_production_age_code;
+typedef struct ccomm_production_age {
+  int32_t code;      /**< ccomm_production_age_code */
+  int32_t known;     /**< 1 for CCOMM_PAGE_SYNCED and _SAME_NODE (age_ns valid), else 0 */
+  int64_t age_ns;    /**< since the producer wrote the value, as of this call; -1 when unknown */
+  int64_t error_ns;  /**< |true age - age_ns| <= error_ns (the two clocks' bounds plus 1 us for reading
+                          them); -1 when unknown: never an age presented as exact when it is not */
+} ccomm_production_age;
+/**
+ * The production age of the value a read of signal `s` returned (`info`, as ccomm_read*
+ * filled it), as of now. Needs the view (ccomm_view_open, once, at start-up: not a
+ * real-time call); this call itself is bounded and allocation-free: two seqlock reads of
+ * view records (no waiting: a record being rewritten gives CCOMM_PAGE_NO_SUMMARY) and
+ * one CLOCK_REALTIME reading. 0, or CCOMM_E_INVAL (bad view, signal or info). Growable.
+ */
+CCOMM_API int ccomm_view_production_age_sized(const ccomm_view* v, ccomm_signal s, const ccomm_info* info,
+                                              ccomm_production_age* out, size_t size);
+#define ccomm_view_production_age(v, s, info, out) \
+  ccomm_view_production_age_sized((v), (s), (info), (out), sizeof(*(out)))
+
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or node index, CCOMM_E_BUSY if the record
  *  was being rewritten throughout ~50 ms of waiting (ccommd stopped mid-rewrite). The view
  *  calls may sleep: they are for monitoring tools, not for a control loop. */

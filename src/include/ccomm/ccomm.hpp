@@ -176,4 +176,44 @@ class Client {
   int error_ = 0;
 };
 
+/// The system view (ccomm_view_*): every node as its summaries describe it, and the
+/// production age of a value read here. Open it once at start-up; the client must
+/// outlive it.
+class SystemView {
+ public:
+  explicit SystemView(const Client& c) { error_ = ccomm_view_open(c.raw(), &v_); }
+  ~SystemView() { ccomm_view_close(v_); }
+  SystemView(const SystemView&) = delete;
+  SystemView& operator=(const SystemView&) = delete;
+  SystemView(SystemView&& o) noexcept : v_(std::exchange(o.v_, nullptr)), error_(o.error_) {}
+  SystemView& operator=(SystemView&& o) noexcept {
+    if (this != &o) {
+      ccomm_view_close(v_);
+      v_ = std::exchange(o.v_, nullptr);
+      error_ = o.error_;
+    }
+    return *this;
+  }
+  bool ok() const { return v_ != nullptr; }
+  int error() const { return error_; }  // CCOMM_E_NOENT: no ccommd (or none with a view)
+  ccomm_view* raw() const { return v_; }
+
+  /// Node `n` (not real-time: may wait up to ~50 ms for a record being rewritten).
+  int node(int n, ccomm_view_node& out) const { return ccomm_view_get_node(v_, n, &out); }
+  /// How long ago the producer wrote the value `r` holds, with its error bound, or why
+  /// that is unknown (ccomm_view_production_age; bounded, allocation-free).
+  template <typename T>
+  ccomm_production_age production_age(const Signal<T>& s, const Reading<T>& r) const {
+    ccomm_production_age a{};
+    a.code = CCOMM_PAGE_NO_SUMMARY;
+    a.age_ns = a.error_ns = -1;
+    if (ccomm_view_production_age(v_, s.id(), &r.info, &a) != 0) a.known = 0;
+    return a;
+  }
+
+ private:
+  ccomm_view* v_ = nullptr;
+  int error_ = 0;
+};
+
 }  // namespace ccomm

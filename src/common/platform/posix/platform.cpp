@@ -33,6 +33,19 @@ uint64_t MonotonicNs() {
   return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
 }
 
+uint64_t RealtimeNs() {
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+int64_t RealtimeOffsetNs() {
+  const uint64_t before = MonotonicNs();
+  const uint64_t real = RealtimeNs();
+  const uint64_t after = MonotonicNs();
+  return static_cast<int64_t>(real - (before + (after - before) / 2));
+}
+
 // Shared (not FUTEX_PRIVATE_FLAG): the word lives in a segment mapped by several processes.
 void FutexWake(std::atomic<uint32_t>* word, int n) {
   syscall(SYS_futex, reinterpret_cast<uint32_t*>(word), FUTEX_WAKE, n, nullptr, nullptr, 0);

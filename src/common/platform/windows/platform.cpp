@@ -183,6 +183,20 @@ uint64_t MonotonicNs() {
   return ticks / f * 1000000000ull + ticks % f * 1000000000ull / f;
 }
 
+uint64_t RealtimeNs() {
+  FILETIME ft;
+  GetSystemTimePreciseAsFileTime(&ft);  // 100 ns units since 1601
+  const uint64_t t = (uint64_t{ft.dwHighDateTime} << 32) | ft.dwLowDateTime;
+  return (t - 116444736000000000ull) * 100;
+}
+
+int64_t RealtimeOffsetNs() {
+  const uint64_t before = MonotonicNs();
+  const uint64_t real = RealtimeNs();
+  const uint64_t after = MonotonicNs();
+  return static_cast<int64_t>(real - (before + (after - before) / 2));
+}
+
 void FutexPrepare(std::atomic<uint32_t>* word) {
   Locked lock;
   const uintptr_t key = reinterpret_cast<uintptr_t>(word);

@@ -5,8 +5,10 @@
 # qemu-tests: ccomm-ptp4l.service on both boards (ptp4l configured by ccommd --clock-config,
 # qemu-tests: IEEE 802.3 over the bridge). Checks that ccommd reports the clock state
 # qemu-tests: ptp4l has (planner: synced) and reports the sync error the slave measured
-# qemu-tests: once locked (ptp4l's "master offset": rms and largest). The harness puts
-# qemu-tests: the original signals.xml back afterwards.
+# qemu-tests: once locked (ptp4l's "master offset": rms and largest). Then the true one-way
+# qemu-tests: latency (a control write to its read on the planner, aged by production
+# qemu-tests: through stale_by="production") next to RTT/2 in the same run. The harness
+# qemu-tests: puts the original signals.xml back afterwards.
 # qemu-tests: timeout=300
 . "$(dirname "$0")/../lib/common.sh"
 need_ccomm
@@ -23,8 +25,13 @@ done
 vm control "test -f $UNIT" || finish
 note "planner eth0: $(vm planner 'ethtool -T eth0 2>/dev/null | grep -i software | tr -s "\t\n " " "')"
 
+# The signal whose one-way latency is measured: a double control writes, aged on the
+# planner from its production (stale_by is local policy: the boards keep one config hash).
+sig=$(vm control 'ccomm list' | awk 'NR > 1 && $5 == "control" && $3 == "double" {print $2; exit}')
+back=$(vm planner 'ccomm list' | awk 'NR > 1 && $5 == "planner" && $3 == "double" {print $2; exit}')
 for b in control planner; do
-	vm "$b" "sed -i 's|</ccomm>|  <clock grandmaster=\"control\" timestamping=\"software\" sync_interval_log=\"-3\"/>\n</ccomm>|' $CFG"
+	vm "$b" "sed -i 's|</ccomm>|  <clock grandmaster=\"control\" timestamping=\"software\" sync_interval_log=\"-3\"/>\n</ccomm>|; \
+s|<signal name=\"$sig\" |<signal name=\"$sig\" stale_by=\"production\" |' $CFG"
 	check "$b: signals.xml with <clock> passes ccommd --check" vm "$b" "ccommd --config $CFG --check >/dev/null"
 	check "$b: ccommd --clock-config gives ptp4l its role" \
 		vm "$b" "ccommd --config $CFG --clock-config | grep -q '^priority1'"
@@ -56,9 +63,31 @@ if wait_until "$LOCK_TIMEOUT" synced; then
 		awk '{ for (i = 1; i < NF; i++) { if ($i == "rms") { r = $(i + 1); n++; s += r * r } if ($i == "max" && $(i + 1) > m) m = $(i + 1)
 		                                   if ($i == "delay") { d += $(i + 1); nd++ } } }
 		     END { if (n) printf "{\"seconds\":%d,\"offset_rms_ns\":%.0f,\"offset_max_ns\":%d,\"path_delay_ns\":%.0f}\n", n, sqrt(s / n), m, nd ? d / nd : 0 }')
-	echo "$stats" >"$OUT"
 	note "sync error over the last ${SYNC_SECONDS} s (ptp4l on planner; software timestamps on emulated boards): $stats"
 	check "sync error measured from ptp4l's offsets" test -n "$stats"
+
+	# One-way: control writes $sig at 100 Hz; the planner's ccommd stamps each value with
+	# its production time on control (mapped through the PTP time base), so the read's age
+	# at the planner is write -> read across the boards ("last hop" of --stages).
+	vm_bg planner oneway "ccomm-latency --mode oneway --send $back --recv $sig -r 100 -d 8 --warmup 1 \
+--prio 70 --stages /run/ccq-oneway.stages --label oneway" >/dev/null
+	vm --timeout 60 control "ccomm-latency --mode oneway --send $sig --recv $back -r 100 -d 8 --warmup 1 --prio 70 \
+--label oneway-control" >/dev/null 2>&1
+	vm_bg_wait planner oneway 60 >/dev/null
+	oneway=$(vm planner 'cut -f2 /run/ccq-oneway.stages' | sort -n |
+		awk '{ v[n++] = $1 } END { if (n) printf "{\"count\":%d,\"p50_ns\":%d,\"p99_ns\":%d,\"max_ns\":%d}\n", n, v[int(n * 0.5)], v[int(n * 0.99)], v[n - 1] }')
+	by_arrival=$(vm planner 'journalctl -u ccommd -o cat --no-pager | grep -c "judged by their arrival" || true')
+	# RTT/2 in the same run, same signals, same rate
+	vm_bg planner echo "ccomm-latency --mode echo --send $back --recv $sig -r 100 -d 12 --prio 70" >/dev/null
+	sleep 1
+	rtt=$(vm --timeout 60 control "ccomm-latency --mode ping --send $sig --recv $back -r 100 -d 6 --warmup 1 --prio 70 \
+--label rtt2" 2>/dev/null | grep -m1 '^{')
+	vm_bg_stop planner echo >/dev/null
+	note "one-way write -> read, control -> planner, 100 Hz (production age): $oneway"
+	note "RTT/2 in the same run: $rtt"
+	note "error bound of the one-way figure: both clocks' sync error (above); frames judged by arrival (clocks not synced at that moment): $by_arrival log lines"
+	printf '{"sync":%s,"oneway":%s,"rtt2":%s}\n' "${stats:-null}" "${oneway:-null}" "${rtt:-null}" >"$OUT"
+	check "one-way latency measured from production ages" test -n "$oneway"
 else
 	fail "planner's ccommd did not report a synced clock within ${LOCK_TIMEOUT} s ($(clock_line planner))"
 	vm planner 'journalctl -u ccomm-ptp4l -o cat --no-pager | tail -n 20'

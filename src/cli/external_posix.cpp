@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-const char* MissingToolHint(const char* cmd);  // main.cpp
+int CannotRun(const char* cmd, const char* prog, int err, const char* usage);  // main.cpp
 
 int CmdGen(const char* node, int argc, char** argv) {
   if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
@@ -56,15 +56,5 @@ int RunExternal(const char* node, const char* cmd, int argc, char** argv, const 
   for (int i = 1; i < argc; ++i) args.push_back(argv[i]);
   args.push_back(nullptr);
   execvp(prog.c_str(), args.data());
-  if (errno == ENOENT) {
-    const char* hint = MissingToolHint(cmd);
-    if (hint) {
-      fprintf(stderr, "ccomm: %s is not installed (no %s in PATH): %s\n", cmd, prog.c_str(), hint);
-      return 1;
-    }
-    fprintf(stderr, "ccomm: unknown command '%s' (no %s in PATH)\n%s", cmd, prog.c_str(), usage);
-    return 2;
-  }
-  fprintf(stderr, "ccomm: cannot run %s: %s\n", prog.c_str(), strerror(errno));
-  return 1;
+  return CannotRun(cmd, prog.c_str(), errno, usage);
 }

@@ -246,12 +246,28 @@ int CmdStats(ccomm_client* c, const char* node, int argc, char** argv);  // stat
 int CmdGen(const char* node, int argc, char** argv);
 int RunExternal(const char* node, const char* cmd, int argc, char** argv, const char* usage);
 
+namespace {
 // The tools that ship elsewhere say where they come from (nullptr: not one of them).
 const char* MissingToolHint(const char* cmd) {
   return !strcmp(cmd, "ros2") ? "ccomm-ros2 is built when Cyclone DDS is found (Debian: cyclonedds-dev, cyclonedds-tools)"
          : (!strcmp(cmd, "record") || !strcmp(cmd, "replay")) ? "it comes with the Python package: pip install 'ccomm[record]'"
          : !strcmp(cmd, "web") ? "it comes with the Python package: pip install 'ccomm[web]'"
          : nullptr;
+}
+}  // namespace
+
+// Why `ccomm CMD` could not run PROG (err: the errno of the exec or spawn), as exit status.
+int CannotRun(const char* cmd, const char* prog, int err, const char* usage) {
+  if (err == ENOENT) {
+    if (const char* hint = MissingToolHint(cmd)) {
+      fprintf(stderr, "ccomm: %s is not installed (no %s in PATH): %s\n", cmd, prog, hint);
+      return 1;
+    }
+    fprintf(stderr, "ccomm: unknown command '%s' (no %s in PATH)\n%s", cmd, prog, usage);
+    return 2;
+  }
+  fprintf(stderr, "ccomm: cannot run %s: %s\n", prog, strerror(err));
+  return 1;
 }
 
 int main(int argc, char** argv) {

@@ -238,7 +238,15 @@ bool SystemViewWriter::SyncedClockOffset(uint32_t node, uint64_t now, int64_t* o
   return true;
 }
 
-void SystemViewWriter::SetClockWords(uint32_t node, const wire::SummaryHead& head) {
+void SystemViewWriter::SetHeadWords(uint32_t node, const wire::SummaryHead& head) {
+  view_.SetNodeWord(node, store::kVwUptimeNs, head.uptime_ns);
+  view_.SetNodeWord(node, store::kVwPeersAlive, head.peers_alive);
+  view_.SetNodeWord(node, store::kVwFramesRx, head.frames_rx);
+  view_.SetNodeWord(node, store::kVwFramesTx, head.frames_tx);
+  view_.SetNodeWord(node, store::kVwFramesBad, head.frames_bad);
+  view_.SetNodeWord(node, store::kVwFramesLost, head.frames_lost);
+  view_.SetNodeWord(node, store::kVwSocketDrops, head.socket_drops);
+  view_.SetNodeWord(node, store::kVwCycleMs, head.cycle_ms);
   view_.SetNodeWord(node, store::kVwClockState, head.clock_state);
   view_.SetNodeWord(node, store::kVwClockErrorNs, head.clock_error_ns);
   view_.SetNodeWord(node, store::kVwClockOffsetNs, static_cast<uint64_t>(head.clock_offset_ns));
@@ -248,15 +256,7 @@ void SystemViewWriter::WriteSelf(const wire::SummaryHead& head, uint32_t first, 
   view_.BeginWrite(self_);
   view_.SetNodeWord(self_, store::kVwLastRxNs, now);
   view_.SetNodeWord(self_, store::kVwTimeoutNs, AliveTimeoutNs(interval_ns_, cfg_->network.peer_timeout_ms));
-  view_.SetNodeWord(self_, store::kVwUptimeNs, head.uptime_ns);
-  view_.SetNodeWord(self_, store::kVwPeersAlive, head.peers_alive);
-  view_.SetNodeWord(self_, store::kVwFramesRx, head.frames_rx);
-  view_.SetNodeWord(self_, store::kVwFramesTx, head.frames_tx);
-  view_.SetNodeWord(self_, store::kVwFramesBad, head.frames_bad);
-  view_.SetNodeWord(self_, store::kVwFramesLost, head.frames_lost);
-  view_.SetNodeWord(self_, store::kVwSocketDrops, head.socket_drops);
-  view_.SetNodeWord(self_, store::kVwCycleMs, head.cycle_ms);
-  SetClockWords(self_, head);
+  SetHeadWords(self_, head);
   for (uint32_t i = first; i < end; ++i) {
     const wire::SummaryRecord& r = reported_[i].rec;
     view_.SetRow(self_, r.signal, r.role, r.flags, r.rate_mhz, r.lost, r.age_ms, now);
@@ -316,16 +316,8 @@ SystemViewWriter::Verdict SystemViewWriter::Receive(const uint8_t* frame, const 
   view_.BeginWrite(node);
   view_.SetNodeWord(node, store::kVwLastRxNs, now);
   view_.SetNodeWord(node, store::kVwTimeoutNs, timeout);
-  view_.SetNodeWord(node, store::kVwUptimeNs, head.uptime_ns);
-  view_.SetNodeWord(node, store::kVwPeersAlive, head.peers_alive);
-  view_.SetNodeWord(node, store::kVwFramesRx, head.frames_rx);
-  view_.SetNodeWord(node, store::kVwFramesTx, head.frames_tx);
-  view_.SetNodeWord(node, store::kVwFramesBad, head.frames_bad);
-  view_.SetNodeWord(node, store::kVwFramesLost, head.frames_lost);
-  view_.SetNodeWord(node, store::kVwSocketDrops, head.socket_drops);
-  view_.SetNodeWord(node, store::kVwCycleMs, head.cycle_ms);
   view_.SetNodeWord(node, store::kVwSummaries, parts_seen + 1);
-  SetClockWords(node, head);
+  SetHeadWords(node, head);
   for (uint16_t i = 0; i < head.record_count; ++i) {
     wire::SummaryRecord r;
     wire::ReadSummaryRecord(frame, i, &r);

@@ -77,7 +77,7 @@ class SystemViewWriter {
 
   void Snapshot(uint64_t now);
   void SendPart(uint32_t part, uint64_t now);
-  void SetClockWords(uint32_t node, const wire::SummaryHead& head);  // inside Begin/EndWrite
+  void SetHeadWords(uint32_t node, const wire::SummaryHead& head);  // the head's words; inside Begin/EndWrite
   void WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now);
 
   const SystemConfig* cfg_ = nullptr;

@@ -266,35 +266,27 @@ def check_same(orig: str, replayed: str, tol_ms: float, stats: dict, config: str
         return 1
     # The documented tolerance: p99 within a fifth of it, every value within it (a Python
     # replayer on a general-purpose kernel: the odd wake-up is late, the bulk is not).
-    if p99 > tol_ms * 1e6 / 5:
-        # The floor (tests/record/run, cyclictest above every task of the test, same
-        # window): the lateness the machine itself imposed on 1% of the time. A replayed
-        # value waits for two wake-ups (the replayer's, ccommd's sender's), so a machine
-        # late by at least half the replay's p99 for 1% of the time explains it.
-        host_p99_ns = float(os.environ.get("RECORDCHECK_HOST_P99_US", "0")) * 1e3
-        steal = float(os.environ.get("RECORDCHECK_HOST_STEAL_PERMILLE", "0")) / 10
-        if steal >= 1.0:  # the machine was not there for more than 1% of the time: no p99 to judge
-            print(f"# the p99 {p99 / 1e6:.3f} ms is the machine's: the hypervisor took {steal:.1f}% of the CPUs' "
-                  f"time in the same window (steal)")
+    # The floor (tests/record/run: cyclictest above every task of the test, and the
+    # hypervisor's steal, in the same window). A replayed value waits for two wake-ups (the
+    # replayer's, ccommd's sender's), so a machine late by at least half the excess explains
+    # it; anything else is the replayer's (or ccomm's) doing.
+    floor = {"p99": (float(os.environ.get("RECORDCHECK_HOST_P99_US", "0")) * 1e3,
+                     "cyclictest above every task of the test was late by {:.3f} ms or more for 1% of the window"),
+             "max": (float(os.environ.get("RECORDCHECK_HOST_STALL_US", "0")) * 1e3,
+                     "cyclictest above every task of the test was kept from running for {:.3f} ms in the window")}
+    steal = float(os.environ.get("RECORDCHECK_HOST_STEAL_PERMILLE", "0")) / 10
+    for what, value, limit in (("p99", p99, tol_ms * 1e6 / 5), ("max", worst, tol_ms * 1e6)):
+        if value <= limit:
+            continue
+        host_ns, says = floor[what]
+        if what == "p99" and steal >= 1.0:  # the machine was not there for 1% of the time: no p99 to judge
+            print(f"# the {what} {value / 1e6:.3f} ms is the machine's: the hypervisor took {steal:.1f}% of the "
+                  f"CPUs' time in the window (steal)")
             return 5
-        if host_p99_ns >= p99 / 2:
-            print(f"# the p99 {p99 / 1e6:.3f} ms is the machine's: cyclictest above every task of the test "
-                  f"was late by {host_p99_ns / 1e6:.3f} ms or more for 1% of the same window")
+        if host_ns >= value / 2:
+            print(f"# the {what} {value / 1e6:.3f} ms is the machine's: " + says.format(host_ns / 1e6))
             return 5
-        print(f"# the machine itself was late by {host_p99_ns / 1e6:.3f} ms or more for 1% of that window "
-              f"(cyclictest): not the cause")
-        return 4
-    if worst > tol_ms * 1e6:
-        # The floor (tests/record/run): the longest the machine itself kept cyclictest, above
-        # every task of the test, from running. A stall of at least half the worst error in
-        # the same window explains it; anything else is the replayer's (or ccomm's) doing.
-        stall_ns = float(os.environ.get("RECORDCHECK_HOST_STALL_US", "0")) * 1e3
-        if stall_ns >= worst / 2:
-            print(f"# the worst value's {worst / 1e6:.3f} ms is the machine's: cyclictest above every task of the "
-                  f"test was kept from running for {stall_ns / 1e6:.3f} ms in the same window")
-            return 5
-        print(f"# the machine itself stalled at most {stall_ns / 1e6:.3f} ms in that window (cyclictest): "
-              f"not the cause")
+        print(f"# not the machine's: " + says.format(host_ns / 1e6))
         return 4
     return 3 if missing else 0
 

@@ -253,3 +253,46 @@ sys.exit(1 if fresh_old or stale_young or first == 0 else 0)'
 check "link cut: the Windows reader sees the Linux signal stale after stale_after_ms (20 ms), never fresh older" link_cut
 
 kill $lpid $wpid 2>/dev/null; wait $lpid $wpid 2>/dev/null
+
+# ---- e. multicast ----------------------------------------------------------------------
+# The same two nodes with fanout="multicast": each producer sends one frame per cycle to
+# its own group (multicast_base + node ID), each consumer joins its producers' groups, so
+# the Windows ccommd reads through a Winsock group membership on the veth.
+sed 's|<network |<network fanout="multicast" |' "$sim" >"$W/multicast.xml"
+simm=$(winepath_of "$W/multicast.xml")
+"${in_l[@]}" "$LBIN/ccommd" --node control -c "$W/multicast.xml" --no-rt >"$W/linux-ccommd-m.log" 2>&1 &
+lpid=$!
+"${in_w[@]}" "$WBIN/ccommd.exe" --node planner -c "$simm" --no-rt >"$W/wine-ccommd-m.log" 2>&1 &
+wpid=$!
+multicast() {
+  peers_up || return 1
+  lstats >"$W/lm0.json" && wstats >"$W/wm0.json" || return 1
+  # 2000 values each way at 200 Hz (10 s: Wine starts its echo in seconds): Linux -> the group
+  # -> Windows, and back
+  "${in_l[@]}" "$LBIN/ccomm" --node control pub wheel0_pos 1.25 --rate 200 --count 2000 >/dev/null &
+  local lp=$!
+  "${in_w[@]}" "$WBIN/ccomm.exe" --node planner pub base_theta_sp 0.5 --rate 200 --count 2000 >/dev/null 2>&1 &
+  local wp=$!
+  local got_w got_l
+  got_w=$("${in_w[@]}" "$WBIN/ccomm.exe" --node planner echo wheel0_pos -n 1 --timeout 30 | tr -d '\r')
+  got_l=$("${in_l[@]}" "$LBIN/ccomm" --node control echo base_theta_sp -n 1 --timeout 30)
+  wait $lp $wp
+  local deadline=$((SECONDS + 30)) to_w to_l
+  while :; do
+    lstats >"$W/lm1.json" && wstats >"$W/wm1.json" || return 1
+    to_w=$(counters "$W/lm0.json" "$W/lm1.json" "$W/wm0.json" "$W/wm1.json")
+    to_l=$(counters "$W/wm0.json" "$W/wm1.json" "$W/lm0.json" "$W/lm1.json")
+    # every write sent (or replaced unsent by the next one: coalesced) and received
+    read -r txw rxw lostw badw _ cow <<<"$to_w"; read -r txl rxl lostl badl _ col <<<"$to_l"
+    [[ ($badw -eq 0 && $badl -eq 0 && $((txw + cow)) -ge 2000 && $((txl + col)) -ge 2000) || $SECONDS -ge $deadline ]] && break
+    sleep 0.5
+  done
+  say "  multicast: Windows read wheel0_pos '$(echo $got_w | awk '{print $2, $3}')', Linux read base_theta_sp" \
+      "'$(echo $got_l | awk '{print $2, $3}')'; Linux -> group -> Windows $txw sent, $rxw received, $lostw lost;" \
+      "Windows -> group -> Linux $txl sent, $rxl received, $lostl lost"
+  [[ $(echo "$got_w" | awk '{print $2}') == 1.25 && $(echo "$got_l" | awk '{print $2}') == 0.5 &&
+     $((txw + cow)) -ge 2000 && $((txl + col)) -ge 2000 && $badw -eq 0 && $badl -eq 0 && $lostw -eq 0 && $lostl -eq 0 ]] ||
+    { echo "Linux ccommd:"; tail -5 "$W/linux-ccommd-m.log"; echo "ccommd.exe:"; tail -5 "$W/wine-ccommd-m.log"; return 1; }
+}
+check "fanout=multicast: Linux and Windows ccommd each read the other's signal through its group, rx == tx, 0 lost" multicast
+kill $lpid $wpid 2>/dev/null; wait $lpid $wpid 2>/dev/null

@@ -26,6 +26,7 @@ as much.
 import json
 import os
 import re
+import subprocess
 import sys
 from collections import defaultdict
 
@@ -140,7 +141,10 @@ def check_ros2(path: str, config: str, node: str) -> int:
 
 
 def produced_by(config: str, node: str) -> list:
-    return re.findall(r'<signal name="([^"]+)" type="double" producer="%s"' % node, open(config).read())
+    """The double signals `node` produces, as ccommd reads `config` (the one parser)."""
+    ccommd = os.path.join(os.environ["CCOMM_BUILD_DIR"], "bin", "ccommd")
+    out = subprocess.run([ccommd, "--check", "--json", "-c", config], capture_output=True, text=True, check=True).stdout
+    return [s["name"] for s in json.loads(out)["signals"] if s["producer"] == node and s["type"] == "double"]
 
 
 def load_stats(args: list) -> dict:

@@ -11,7 +11,7 @@ export FUZZ_SECONDS=${FUZZ_SECONDS:-20}
 "$ROOT/scripts/fuzz" >"$WORK/fuzz.log" 2>&1
 rc=$?
 grep '^fuzz: ' "$WORK/fuzz.log" | sed 's/^fuzz: /# figure: fuzz: /'
-for t in $(grep -o 'running [a-z_]*' "$WORK/fuzz.log" | awk '{print $2}'); do
+for t in $(grep -o 'running [a-z0-9_]*' "$WORK/fuzz.log" | awk '{print $2}'); do
   if grep -q "FAILED:.*$t" "$WORK/fuzz.log" || ! grep -q "^fuzz: $t stat::number_of_executed_units" "$WORK/fuzz.log"; then
     not_ok "$t: ${FUZZ_SECONDS}s without a finding"
   else

@@ -82,13 +82,7 @@ class QueuedFrameTest : public testing::ReceivingDaemonTest {
   void Send(uint32_t seq, uint32_t value_seq, double v, uint64_t send_ns) {
     std::vector<uint8_t> buf(wire::kMaxFrameSize);
     wire::FrameWriter w(buf.data(), buf.size());
-    wire::FrameHeader h;
-    h.sender = 1;
-    h.dest = 0;
-    h.config_hash = cfg_.hash;
-    h.seq = seq;
-    h.send_time_ns = send_ns;
-    w.Begin(h);
+    w.Begin(PeerFrameHeader(seq, send_ns));
     ASSERT_TRUE(w.Add(kStateId, static_cast<uint8_t>(ValueType::kDouble), 0, 1, value_seq, send_ns, &v, 8));
     const size_t len = w.Finish();
     ASSERT_EQ(sendto(tx_, buf.data(), len, 0, reinterpret_cast<const sockaddr*>(&to_), sizeof to_),

@@ -18,6 +18,7 @@
 #include "common/platform.h"
 #include "daemon/daemon.h"
 #include "testing/test_config.h"
+#include "wire/wire.h"
 
 namespace ccomm {
 namespace testing {
@@ -50,6 +51,17 @@ class ReceivingDaemonTest : public ::testing::Test {
     daemon_.Shutdown();
     if (tx_ >= 0) close(tx_);
     platform::ShmUnlink(store::SegmentName("a").c_str());
+  }
+  // The header of a data frame from node 1 (the peer, `tx_`) to node 0, sent at `send_ns`
+  // on the peer's clock.
+  wire::FrameHeader PeerFrameHeader(uint32_t seq, uint64_t send_ns) const {
+    wire::FrameHeader h;
+    h.sender = 1;
+    h.dest = 0;
+    h.config_hash = cfg_.hash;
+    h.seq = seq;
+    h.send_time_ns = send_ns;
+    return h;
   }
   // A UDP socket bound to `ip` (any port): frames from it come from that node's address.
   static int BoundSocket(const char* ip) {

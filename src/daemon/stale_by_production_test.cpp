@@ -64,13 +64,7 @@ class StaleByProductionTest : public testing::ReceivingDaemonTest {
   void SendValues(uint32_t seq, uint64_t b_monotonic_now, uint64_t written_ago) {
     std::vector<uint8_t> buf(wire::kMaxFrameSize);
     wire::FrameWriter w(buf.data(), buf.size());
-    wire::FrameHeader h;
-    h.sender = 1;
-    h.dest = 0;
-    h.config_hash = cfg_.hash;
-    h.seq = seq;
-    h.send_time_ns = b_monotonic_now;
-    w.Begin(h);
+    w.Begin(PeerFrameHeader(seq, b_monotonic_now));
     const double v = seq;
     const uint8_t dbl = static_cast<uint8_t>(ValueType::kDouble);
     ASSERT_TRUE(w.Add(kByProduction, dbl, 0, 1, seq, b_monotonic_now - written_ago, &v, 8));

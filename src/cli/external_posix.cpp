@@ -11,14 +11,7 @@
 
 int CannotRun(const char* cmd, const char* prog, int err, const char* usage);  // main.cpp
 
-int CmdGen(const char* node, int argc, char** argv) {
-  if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
-    fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
-    return 2;
-  }
-  // The generator is a Python script installed with the integrations.
-  const char* gen = getenv("CCOMM_GEN_20SIM4C");
-  std::string path = gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py";
+int RunGenerator(const char* node, std::string path, int argc, char** argv) {
   // It reads signals.xml through `ccommd --check --json`: in a build tree the ccommd beside
   // this program, installed the one in sbin (the generator looks there).
   char self[4096];

@@ -31,15 +31,8 @@ int Spawn(const char* file, const std::vector<std::string>& args) {
 
 }  // namespace
 
-int CmdGen(const char* node, int argc, char** argv) {
-  if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
-    fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
-    return 2;
-  }
-  // The generator is a Python script installed with the integrations; it reads signals.xml
-  // through `ccommd --check --json`, with the ccommd.exe beside this program.
-  const char* gen = getenv("CCOMM_GEN_20SIM4C");
-  std::string path = gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py";
+int RunGenerator(const char* node, std::string path, int argc, char** argv) {
+  // It reads signals.xml through `ccommd --check --json`, with the ccommd.exe beside this program.
   char self[MAX_PATH];
   const DWORD len = GetModuleFileNameA(nullptr, self, sizeof self);
   if (!getenv("CCOMM_CCOMMD") && len > 0 && len < sizeof self) {

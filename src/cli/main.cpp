@@ -243,7 +243,18 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
 
 int CmdStats(ccomm_client* c, const char* node, int argc, char** argv);  // stats.cpp
 // Other programs (external_posix.cpp, external_windows.cpp).
-int CmdGen(const char* node, int argc, char** argv);
+int RunGenerator(const char* node, std::string path, int argc, char** argv);
+
+// `ccomm gen 20sim4c ...`: the generator is a Python script installed with the
+// integrations; the platform part runs it.
+int CmdGen(const char* node, int argc, char** argv) {
+  if (argc < 2 || strcmp(argv[1], "20sim4c") != 0) {
+    fprintf(stderr, "ccomm gen: only '20sim4c' is known\n");
+    return 2;
+  }
+  const char* gen = getenv("CCOMM_GEN_20SIM4C");
+  return RunGenerator(node, gen ? gen : CCOMM_DATADIR "/integrations/20sim/4c/gen_4c.py", argc, argv);
+}
 int RunExternal(const char* node, const char* cmd, int argc, char** argv, const char* usage);
 
 namespace {

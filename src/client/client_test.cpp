@@ -29,19 +29,19 @@ class ClientTest : public ::testing::Test {
  protected:
   void SetUp() override {
     setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("client").c_str(), 1);
-    auto pos = MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
-    auto sp = MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
+    std::vector<SignalConfig> signals = testing::PosAndSetpoint();
+    SignalConfig& sp = signals[1];
     sp.stale_after_ms = 20;
     sp.has_safe_value = true;
     double safe = -1.0;
     sp.safe_value.resize(8);
     memcpy(sp.safe_value.data(), &safe, 8);
-    auto arr = MakeSignal("arr", ValueType::kInt32, 3, SignalKind::kState, 0, {});
-    auto ev = MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 0, {});
-    ev.queue_depth = 8;
-    auto local = MakeSignal("local", ValueType::kFloat, 1, SignalKind::kState, 0, {0});
-    local.stale_after_ms = 1000;
-    cfg_ = TwoNodeConfig({pos, sp, arr, ev, local});
+    signals.push_back(MakeSignal("arr", ValueType::kInt32, 3, SignalKind::kState, 0, {}));
+    signals.push_back(MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 0, {}));
+    signals.back().queue_depth = 8;
+    signals.push_back(MakeSignal("local", ValueType::kFloat, 1, SignalKind::kState, 0, {0}));
+    signals.back().stale_after_ms = 1000;
+    cfg_ = TwoNodeConfig(signals);
     std::string err;
     bool adopted;
     ASSERT_EQ(CreateOrAdoptSegment(&seg_a_, cfg_, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;

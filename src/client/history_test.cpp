@@ -27,10 +27,9 @@ class HistoryTest : public ::testing::Test {
  protected:
   void SetUp() override {
     setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("history").c_str(), 1);
-    auto pos = MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
-    auto sp = MakeSignal("sp", ValueType::kDouble, 2, SignalKind::kState, 1, {0});
-    auto ev = MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 1, {0});
-    cfg_ = testing::TwoNodeConfig({pos, sp, ev});
+    std::vector<SignalConfig> signals = testing::PosAndSetpoint(2);
+    signals.push_back(MakeSignal("estop", ValueType::kBool, 1, SignalKind::kEvent, 1, {0}));
+    cfg_ = testing::TwoNodeConfig(signals);
     cfg_.nodes[0].history = kDepth;
     std::string err;
     bool adopted;

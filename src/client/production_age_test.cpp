@@ -31,9 +31,7 @@ class ProductionAgeTest : public ::testing::Test {
   void SetUp() override {
     setenv("CCOMM_SHM_PREFIX", testing::UniquePrefix("page").c_str(), 1);
     // Node a (0, this one) produces "pos"; node b (1) produces "sp", which a consumes.
-    auto pos = MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
-    auto sp = MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
-    cfg_ = testing::TwoNodeConfig({pos, sp});
+    cfg_ = testing::TwoNodeConfig(testing::PosAndSetpoint());
     std::string err;
     bool adopted;
     ASSERT_EQ(CreateOrAdoptSegment(&seg_, cfg_, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;

@@ -5,18 +5,12 @@
 #include <string>
 
 #include "config/config.h"
+#include "testing/config_document.h"
 
 namespace ccomm {
 namespace {
 
-std::string Doc(const std::string& clock) {
-  return "<ccomm version=\"1\">\n"                                                     // 1
-         "  <node name=\"control\" interface=\"eth0\" ip=\"10.42.0.1\"/>\n"            // 2
-         "  <node name=\"planner\" interface=\"eth1\" ip=\"10.42.0.2\"/>\n"            // 3
-         "  <signal name=\"pos\" type=\"double\" producer=\"control\" consumers=\"planner\"/>\n"
-         "  " + clock + "\n"                                                           // 5
-         "</ccomm>\n";
-}
+std::string Doc(const std::string& clock) { return testing::TwoNodeDocument(clock); }  // <clock> on line 5
 
 TEST(ClockSection, ValuesAndDefaults) {
   SystemConfig cfg;

@@ -8,18 +8,12 @@
 #include "config/config.h"
 #include "config/config_json.h"
 #include "config/outline.h"
+#include "testing/config_document.h"
 
 namespace ccomm {
 namespace {
 
-std::string Doc(const std::string& section) {
-  return "<ccomm version=\"1\">\n"                                                     // 1
-         "  <node name=\"control\" interface=\"eth0\" ip=\"10.42.0.1\"/>\n"            // 2
-         "  <node name=\"planner\" interface=\"eth0\" ip=\"10.42.0.2\"/>\n"            // 3
-         "  <signal name=\"pos\" type=\"double\" producer=\"control\" consumers=\"planner\"/>\n"
-         "  " + section + "\n"                                                         // 5
-         "</ccomm>\n";
-}
+std::string Doc(const std::string& section) { return testing::TwoNodeDocument(section); }  // on line 5
 
 TEST(ExtensionSection, KeptAsATreeWithLines) {
   ConfigOutline cfg;

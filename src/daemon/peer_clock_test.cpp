@@ -74,9 +74,7 @@ constexpr uint16_t kStateId = 1;
 class QueuedFrameTest : public testing::ReceivingDaemonTest {
  protected:
   void SetUp() override {
-    auto pos = testing::MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
-    auto sp = testing::MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
-    StartDaemon("peerclk", {pos, sp});
+    StartDaemon("peerclk", testing::PosAndSetpoint());
   }
   // A frame from b (node 1) sent at `send_ns` (b's clock = ours here) carrying sp = v.
   void Send(uint32_t seq, uint32_t value_seq, double v, uint64_t send_ns) {

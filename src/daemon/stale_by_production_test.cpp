@@ -27,13 +27,12 @@ class StaleByProductionTest : public testing::ReceivingDaemonTest {
  protected:
   void SetUp() override {
     // Node a (0) is the daemon under test; b (1) produces both signals.
-    auto pos = testing::MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1});
-    auto prod = testing::MakeSignal("sp", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
-    prod.stale_after_ms = 50;
-    prod.stale_by = StaleBy::kProduction;
-    auto arr = testing::MakeSignal("sq", ValueType::kDouble, 1, SignalKind::kState, 1, {0});
-    arr.stale_after_ms = 50;
-    StartDaemon("staleby", {pos, prod, arr});
+    std::vector<SignalConfig> signals = testing::PosAndSetpoint();
+    signals[1].stale_after_ms = 50;
+    signals[1].stale_by = StaleBy::kProduction;
+    signals.push_back(testing::MakeSignal("sq", ValueType::kDouble, 1, SignalKind::kState, 1, {0}));
+    signals.back().stale_after_ms = 50;
+    StartDaemon("staleby", signals);
   }
   void SendFrame(std::vector<uint8_t>& buf, size_t len) {
     ASSERT_GT(len, 0u);

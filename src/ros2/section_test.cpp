@@ -8,20 +8,17 @@
 
 #include "config/outline.h"
 #include "ros2/section.h"
+#include "testing/config_document.h"
 
 namespace ccomm_ros2 {
 namespace {
 
+// <ros2> on line 8, after the signals it maps.
 std::string Doc(const std::string& ros2) {
-  return "<ccomm version=\"1\">\n"                                                     // 1
-         "  <node name=\"control\" interface=\"eth0\" ip=\"10.42.0.1\"/>\n"            // 2
-         "  <node name=\"planner\" interface=\"eth0\" ip=\"10.42.0.2\"/>\n"            // 3
-         "  <signal name=\"pos\" type=\"double\" producer=\"control\" consumers=\"planner\"/>\n"
-         "  <signal name=\"sp\" type=\"double\" count=\"3\" producer=\"planner\" consumers=\"control\"/>\n"
-         "  <signal name=\"a.b\" type=\"double\" producer=\"control\" consumers=\"planner\"/>\n"
-         "  <signal name=\"loc\" type=\"double\" producer=\"control\"/>\n"
-         "  " + ros2 + "\n"                                                            // 8
-         "</ccomm>\n";
+  return ccomm::testing::TwoNodeDocument(
+      ros2, "  <signal name=\"sp\" type=\"double\" count=\"3\" producer=\"planner\" consumers=\"control\"/>\n"
+            "  <signal name=\"a.b\" type=\"double\" producer=\"control\" consumers=\"planner\"/>\n"
+            "  <signal name=\"loc\" type=\"double\" producer=\"control\"/>\n");
 }
 
 // The file through the core parser, then its <ros2> sections through the bridge's.

@@ -42,6 +42,13 @@ inline SystemConfig TwoNodeConfig(std::vector<SignalConfig> signals) {
   return cfg;
 }
 
+/// The pair most tests start from: "pos" (double, produced by a, consumed by b) and "sp"
+/// (`sp_count` doubles, produced by b, consumed by a), in that order.
+inline std::vector<SignalConfig> PosAndSetpoint(uint32_t sp_count = 1) {
+  return {MakeSignal("pos", ValueType::kDouble, 1, SignalKind::kState, 0, {1}),
+          MakeSignal("sp", ValueType::kDouble, sp_count, SignalKind::kState, 1, {0})};
+}
+
 /// A unique shm prefix per test process, so parallel test runs never share segments.
 /// A UDP port free on loopback right now (tests bind ccommd to it next).
 inline uint16_t FreeUdpPort() {

@@ -81,23 +81,14 @@ class PeerStats(ctypes.Structure):  # ccomm_peer_stats
 
 
 class PeerClock(ctypes.Structure):  # ccomm_peer_clock
-    _fields_ = [
-        ("known", ctypes.c_int32),
-        ("reserved", ctypes.c_int32),
-        ("offset_floor_ns", ctypes.c_int64),
-        ("queue_delay_ns", ctypes.c_uint64),
-        ("queue_delay_max_ns", ctypes.c_uint64),
-        ("frames_delayed", ctypes.c_uint64),
-    ]
+    _fields_ = [("known", ctypes.c_int32), ("reserved", ctypes.c_int32), ("offset_floor_ns", ctypes.c_int64),
+                ("queue_delay_ns", ctypes.c_uint64), ("queue_delay_max_ns", ctypes.c_uint64),
+                ("frames_delayed", ctypes.c_uint64)]
 
 
 class ClockState(ctypes.Structure):  # ccomm_clock_state
-    _fields_ = [
-        ("state", ctypes.c_int32),
-        ("port_state", ctypes.c_int32),
-        ("offset_ns", ctypes.c_int64),
-        ("path_delay_ns", ctypes.c_int64),
-    ]
+    _fields_ = [("state", ctypes.c_int32), ("port_state", ctypes.c_int32),
+                ("offset_ns", ctypes.c_int64), ("path_delay_ns", ctypes.c_int64)]
 
 
 class SignalDesc(ctypes.Structure):
@@ -164,12 +155,8 @@ class ViewCounters(ctypes.Structure):
 
 class ProductionAge(ctypes.Structure):
     """ccomm_production_age."""
-    _fields_ = [
-        ("code", ctypes.c_int32),
-        ("known", ctypes.c_int32),
-        ("age_ns", ctypes.c_int64),
-        ("error_ns", ctypes.c_int64),
-    ]
+    _fields_ = [("code", ctypes.c_int32), ("known", ctypes.c_int32),
+                ("age_ns", ctypes.c_int64), ("error_ns", ctypes.c_int64)]
 
 
 # The public structs of ccomm.h by their C name: what the layout test compares.

@@ -118,88 +118,97 @@ class Signal {
   ccomm_signal id_ = CCOMM_E_INVAL;
 };
 
-class Client {
+namespace detail {
+/// A C handle owned by one object (move-only; the close call runs once), and the error
+/// of the call that opened it (or, for Client, of the last signal()).
+// The close call of each handle (a function, not a pointer template argument: a DLL's
+// imported function has no constant address on Windows).
+template <typename H> struct Closer;
+template <> struct Closer<ccomm_client> { static void Close(ccomm_client* c) { ccomm_close(c); } };
+template <> struct Closer<ccomm_view> { static void Close(ccomm_view* v) { ccomm_view_close(v); } };
+
+template <typename H>
+class Owned {
  public:
-  explicit Client(const char* node = nullptr, uint32_t flags = 0) { error_ = ccomm_open(node, flags, &c_); }
-  ~Client() { ccomm_close(c_); }
-  Client(const Client&) = delete;
-  Client& operator=(const Client&) = delete;
-  Client(Client&& o) noexcept : c_(std::exchange(o.c_, nullptr)), error_(o.error_) {}
-  Client& operator=(Client&& o) noexcept {
+  Owned(const Owned&) = delete;
+  Owned& operator=(const Owned&) = delete;
+
+ protected:
+  Owned() = default;
+  ~Owned() { Closer<H>::Close(h_); }
+  Owned(Owned&& o) noexcept : h_(std::exchange(o.h_, nullptr)), error_(o.error_) {}
+  Owned& operator=(Owned&& o) noexcept {
     if (this != &o) {
-      ccomm_close(c_);
-      c_ = std::exchange(o.c_, nullptr);
+      Closer<H>::Close(h_);
+      h_ = std::exchange(o.h_, nullptr);
       error_ = o.error_;
     }
     return *this;
   }
+  H* h_ = nullptr;
+  int error_ = 0;
+};
+}  // namespace detail
 
-  bool ok() const { return c_ != nullptr; }
+class Client : private detail::Owned<ccomm_client> {
+ public:
+  explicit Client(const char* node = nullptr, uint32_t flags = 0) { error_ = ccomm_open(node, flags, &h_); }
+  Client(Client&&) noexcept = default;
+  Client& operator=(Client&&) noexcept = default;
+
+  bool ok() const { return h_ != nullptr; }
   /// Why the open or the last signal() failed (a CCOMM_E_* code; 0: it did not).
   int error() const { return error_; }
   const char* error_text() const { return ccomm_strerror(error_); }
-  ccomm_client* raw() const { return c_; }
-  const char* node() const { return ccomm_node_name(c_); }
+  ccomm_client* raw() const { return h_; }
+  const char* node() const { return ccomm_node_name(h_); }
 
   /// Finds `name` and checks that it is a T. An invalid Signal (valid() == false) if
   /// not; error() says why. Start-up only.
   template <typename T>
   Signal<T> signal(const char* name) {
     using E = typename Element<T>::type;
-    ccomm_signal id = ccomm_find(c_, name);
+    ccomm_signal id = ccomm_find(h_, name);
     if (id < 0) { error_ = id; return Signal<T>(); }
     ccomm_signal_desc d;
-    ccomm_describe(c_, id, &d);
+    ccomm_describe(h_, id, &d);
     if (d.type != TypeCode<E>::value || d.count != Element<T>::count) { error_ = CCOMM_E_TYPE; return Signal<T>(); }
-    return Signal<T>(c_, id);
+    return Signal<T>(h_, id);
   }
 
   /// Cycle time for this handle's reads and writes (see ccomm_set_time); 0 = per call.
-  void set_time(int64_t t_ns) { ccomm_set_time(c_, t_ns); }
+  void set_time(int64_t t_ns) { ccomm_set_time(h_, t_ns); }
   static int64_t now() { return ccomm_now(); }
 
   /// Blocks until something changes (non-real-time consumers).
-  bool wait(int timeout_ms) { return ccomm_wait(c_, timeout_ms) == 1; }
-  bool daemon_alive() const { return ccomm_daemon_alive(c_) == 1; }
+  bool wait(int timeout_ms) { return ccomm_wait(h_, timeout_ms) == 1; }
+  bool daemon_alive() const { return ccomm_daemon_alive(h_) == 1; }
   /// Opened with CCOMM_OPEN_BATCH: hands this step's writes to ccommd at once (call it at
   /// the end of each cycle); 0 or CCOMM_E_BUSY. Real-time safe.
-  int flush() { return ccomm_flush(c_); }
+  int flush() { return ccomm_flush(h_); }
 
   /// Introspection (not real-time): the system's signals and nodes, and the counters.
-  int signal_count() const { return ccomm_signal_count(c_); }
-  int describe(ccomm_signal id, ccomm_signal_desc& out) const { return ccomm_describe(c_, id, &out); }
-  int node_count() const { return ccomm_node_count(c_); }
-  int peer_stats(int node, ccomm_peer_stats& out) const { return ccomm_get_peer_stats(c_, node, &out); }
+  int signal_count() const { return ccomm_signal_count(h_); }
+  int describe(ccomm_signal id, ccomm_signal_desc& out) const { return ccomm_describe(h_, id, &out); }
+  int node_count() const { return ccomm_node_count(h_); }
+  int peer_stats(int node, ccomm_peer_stats& out) const { return ccomm_get_peer_stats(h_, node, &out); }
 
- private:
-  ccomm_client* c_ = nullptr;
-  int error_ = 0;
 };
 
 /// The system view (ccomm_view_*): every node as its summaries describe it, and the
 /// production age of a value read here. Open it once at start-up; the client must
 /// outlive it.
-class SystemView {
+class SystemView : private detail::Owned<ccomm_view> {
  public:
-  explicit SystemView(const Client& c) { error_ = ccomm_view_open(c.raw(), &v_); }
-  ~SystemView() { ccomm_view_close(v_); }
-  SystemView(const SystemView&) = delete;
-  SystemView& operator=(const SystemView&) = delete;
-  SystemView(SystemView&& o) noexcept : v_(std::exchange(o.v_, nullptr)), error_(o.error_) {}
-  SystemView& operator=(SystemView&& o) noexcept {
-    if (this != &o) {
-      ccomm_view_close(v_);
-      v_ = std::exchange(o.v_, nullptr);
-      error_ = o.error_;
-    }
-    return *this;
-  }
-  bool ok() const { return v_ != nullptr; }
+  explicit SystemView(const Client& c) { error_ = ccomm_view_open(c.raw(), &h_); }
+  SystemView(SystemView&&) noexcept = default;
+  SystemView& operator=(SystemView&&) noexcept = default;
+  bool ok() const { return h_ != nullptr; }
   int error() const { return error_; }  // CCOMM_E_NOENT: no ccommd (or none with a view)
-  ccomm_view* raw() const { return v_; }
+  ccomm_view* raw() const { return h_; }
 
   /// Node `n` (not real-time: may wait up to ~50 ms for a record being rewritten).
-  int node(int n, ccomm_view_node& out) const { return ccomm_view_get_node(v_, n, &out); }
+  int node(int n, ccomm_view_node& out) const { return ccomm_view_get_node(h_, n, &out); }
   /// How long ago the producer wrote the value `r` holds, with its error bound, or why
   /// that is unknown (ccomm_view_production_age; bounded, allocation-free).
   template <typename T>
@@ -207,13 +216,10 @@ class SystemView {
     ccomm_production_age a{};
     a.code = CCOMM_PAGE_NO_SUMMARY;
     a.age_ns = a.error_ns = -1;
-    if (ccomm_view_production_age(v_, s.id(), &r.info, &a) != 0) a.known = 0;
+    if (ccomm_view_production_age(h_, s.id(), &r.info, &a) != 0) a.known = 0;
     return a;
   }
 
- private:
-  ccomm_view* v_ = nullptr;
-  int error_ = 0;
 };
 
 }  // namespace ccomm

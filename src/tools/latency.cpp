@@ -52,7 +52,8 @@ const char kUsage[] =
     "                         being the time since ccommd stored the newest value of the cycle\n"
     "                         on this node (so total - last hop = producer write -> ccommd here)\n"
     "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
-    "p999_ns,max_ns,mean_ns,count}.\n";
+    "p999_ns,max_ns,mean_ns,count,overruns,first_k,last_k}; overruns: cycles the sender skipped because it woke\n"
+    "a period late or more (a stalled machine), never written.\n";
 
 struct Options {
   const char* node = nullptr;
@@ -316,10 +317,20 @@ int main(int argc, char** argv) {
   const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
   const uint64_t end = start + static_cast<uint64_t>(o.duration * 1e9);
   uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
+  uint64_t overruns = 0;  // cycles skipped because the loop woke a whole period late or more
   for (uint64_t k = 1;; ++k) {
     next += period;
     ccomm::app::SleepUntilNs(static_cast<int64_t>(next));
-    if (Now() >= end) break;
+    const uint64_t woke = Now();
+    if (woke >= end) break;
+    // Woken after the next cycle's start (the machine stalled this thread): skip the
+    // missed cycles, as a control loop does, instead of writing them back to back, where
+    // ccommd would rightly coalesce them and the peer count them as cycles not seen.
+    if (woke - next >= period) {
+      const uint64_t missed = (woke - next) / period;
+      overruns += missed;
+      next += missed * period;
+    }
     if (s.echo) continue;  // echo only answers, from the receive thread
     s.send_time[k % kHistory] = Now();
     WriteAll(&s, static_cast<double>(k));
@@ -359,10 +370,11 @@ int main(int argc, char** argv) {
   printf("{\"label\":\"%s\",\"mode\":\"%s\",\"node\":\"%s\",\"rate_hz\":%.0f,\"send_signals\":%zu,"
          "\"recv_signals\":%zu,\"sent\":%" PRIu64 ",\"received\":%" PRIu64 ",\"lost\":%" PRIu64
          ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
-         ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu}\n",
+         ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu,"
+         "\"overruns\":%" PRIu64 ",\"first_k\":%" PRIu64 ",\"last_k\":%" PRIu64 "}\n",
          o.label.c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
          s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
-         v.empty() ? -1 : v.back(), mean, v.size());
+         v.empty() ? -1 : v.back(), mean, v.size(), overruns, s.first_k, s.last_k);
   ccomm_close(s.tx_client);
   ccomm_close(s.rx_client);
   return 0;

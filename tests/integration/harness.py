@@ -201,10 +201,11 @@ def peer_stats(stats, name):
 
 
 def wait_for(predicate, timeout, interval=0.01):
-    """Polls until predicate() is truthy; returns seconds taken, or None on timeout."""
+    """Polls until predicate() is truthy; returns seconds taken (never 0.0, which callers'
+    `assert wait_for(...)` would read as a timeout), or None on timeout."""
     start = time.time()
     while time.time() - start < timeout:
         if predicate():
-            return time.time() - start
+            return max(time.time() - start, 1e-9)
         time.sleep(interval)
     return None

@@ -2,6 +2,7 @@
 """N-node harness: one network namespace per node, all on one Linux bridge (as boards on
 one switch), eth0 inside each with 10.43.0.(i+1)/24, one ccommd per namespace. Used by
 the fan-out and monitor tests. Everything is removed again, also when a test fails."""
+import json
 import os
 import uuid
 
@@ -52,6 +53,12 @@ class Nodes(NodePair):
         run(["ip", "link", "del", self.bridge], check=False)
         if os.path.exists(self.config):
             os.unlink(self.config)
+
+    def tx_dropped(self, n):
+        """Frames node n's eth0 dropped on the way out (a veth counts here what its peer's
+        receive backlog refused on a loaded host): sent by ccommd, never on the bridge."""
+        out = run(["ip", "-n", self.ns[n], "-j", "-s", "link", "show", "eth0"]).stdout
+        return int(json.loads(out)[0]["stats64"]["tx"]["dropped"])
 
     def host_veth_rx_packets(self, n):
         """Packets the bridge received from node n (its veth's host side): what n sent."""

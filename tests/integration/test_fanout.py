@@ -53,6 +53,7 @@ def test_fanout(transport, fanout):
             nodes.stats("c1")
         tx0 = counter(nodes.stats("p"), "frames_tx")
         wire0 = nodes.host_veth_rx_packets("p")
+        dropped0 = nodes.tx_dropped("p")
         t0 = time.time()
         nodes.cli("p", "pub", "pos", "1.5", "--rate", "400", "--count", str(VALUES))
         nodes.cli("x", "pub", "aux", "7", "--rate", "400", "--count", "40")
@@ -73,13 +74,15 @@ def test_fanout(transport, fanout):
             assert (s["rx"], s["lost"]) == (xs["tx"], xs["coalesced"]), (n, s, xs)
         frames = counter(nodes.stats("p"), "frames_tx") - tx0
         on_wire = nodes.host_veth_rx_packets("p") - wire0
+        dropped = nodes.tx_dropped("p") - dropped0
         elapsed = time.time() - t0
         # Heartbeats go only to idle streams; allow one per stream per heartbeat period.
         receivers = 1 if fanout == "multicast" else 3
         slack = receivers * (int(elapsed / 0.1) + 4)
         assert receivers * ps["tx"] <= frames <= receivers * VALUES + slack, (frames, elapsed)
-        # + the kernel's own (ARP, IGMP); - the odd frame a veth drops in a burst on a loaded host
-        assert frames - 5 <= on_wire <= frames + 10, (frames, on_wire)
+        # Every frame ccommd sent reached the bridge or is one the kernel counted as dropped
+        # (a veth whose peer's backlog was full on a loaded host); + the kernel's own (ARP, IGMP).
+        assert frames <= on_wire + dropped <= frames + 10, (frames, on_wire, dropped)
         if fanout == "multicast":
             # x exchanges nothing with p: none of p's frames may reach its ccommd (with
             # unicast fan-out, raw frames to nodes without mac= are broadcast to all).

@@ -58,8 +58,10 @@ def test_fanout(transport, fanout):
         nodes.cli("p", "pub", "pos", "1.5", "--rate", "400", "--count", str(VALUES))
         nodes.cli("x", "pub", "aux", "7", "--rate", "400", "--count", "40")
         # The producer's ccommd may coalesce a state value when it runs late (counted there;
-        # a receiver sees the gap in the value sequence as lost): every value sent must
-        # reach every receiver, so rx == p's tx and lost == p's coalesced, exactly.
+        # a receiver sees the gap in the value sequence as lost, but not a gap before the
+        # first value it receives: under load the first values may be coalesced too): every
+        # value sent must reach every receiver, so rx == p's tx exactly, lost <= p's
+        # coalesced, and the last value (seq VALUES) arrived.
         ps = signal_stats(nodes.stats("p"), "pos")
         assert ps["writes"] == VALUES and ps["tx"] + ps["coalesced"] == VALUES, ps
         for n in ("c1", "c2", "m"):
@@ -67,11 +69,12 @@ def test_fanout(transport, fanout):
                 (n, signal_stats(nodes.stats(n), "pos"), ps, nodes.stats(n)["counters"])
         for n in ("c1", "c2", "m"):
             s = signal_stats(nodes.stats(n), "pos")
-            assert (s["rx"], s["lost"]) == (ps["tx"], ps["coalesced"]), (n, s, ps)
+            assert s["rx"] == ps["tx"] and s["lost"] <= ps["coalesced"], (n, s, ps)
+            assert "seq=%d " % VALUES in nodes.cli(n, "echo", "pos", "--once").stdout
         xs = signal_stats(nodes.stats("x"), "aux")
         for n in ("c1", "m"):
             s = signal_stats(nodes.stats(n), "aux")
-            assert (s["rx"], s["lost"]) == (xs["tx"], xs["coalesced"]), (n, s, xs)
+            assert s["rx"] == xs["tx"] and s["lost"] <= xs["coalesced"], (n, s, xs)
         frames = counter(nodes.stats("p"), "frames_tx") - tx0
         on_wire = nodes.host_veth_rx_packets("p") - wire0
         dropped = nodes.tx_dropped("p") - dropped0

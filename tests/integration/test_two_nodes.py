@@ -113,7 +113,10 @@ def test_periodic_mode_sends_once_per_period(tmp_path):
         assert rx <= frames + 5, (rx, frames)  # at most one new value per frame
         if not SANITIZED:  # a sanitized writer may not keep up 1 kHz: then fewer new values
             assert frames >= 150, frames
-            assert frames - 5 <= rx, (rx, frames)
+            # New values in most periods: a writer starved on a loaded machine leaves some
+            # periods without one (then the frame re-sends the old value; 264 of 278 under
+            # two CPU hogs, where it is all of them on a quiet machine).
+            assert 0.8 * frames <= rx, (rx, frames)
             assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh")
         assert writer.wait(timeout=10) == 0
         # The writer stopped; ccommd keeps re-sending 4.5 every 5 ms, and it turns stale.

@@ -3,7 +3,7 @@
 Ethernet and UDP, five namespaces on one bridge:
   p produces `pos` for c1 and c2; x produces `aux` for c1; m is a monitor (monitor="*").
 Checks: every consumer and the monitor get every value (none lost, exact counters);
-p sends ONE frame per value for its three receivers (counted by p's ccommd and on the
+p sends at most ONE frame per value for its three receivers (counted by p's ccommd and on the
 bridge), where unicast fan-out sends three; x, which exchanges nothing with p, never
 sees p's frames (the group filter), so nothing is counted against it."""
 import os
@@ -82,7 +82,10 @@ def test_fanout(transport, fanout):
         # Heartbeats go only to idle streams; allow one per stream per heartbeat period.
         receivers = 1 if fanout == "multicast" else 3
         slack = receivers * (int(elapsed / 0.1) + 4)
-        assert receivers * ps["tx"] <= frames <= receivers * VALUES + slack, (frames, elapsed)
+        # At most one frame per value and stream (no lower bound: a late ccommd puts the
+        # values that waited into one frame, 970 frames for 3 x 385 values under two CPU
+        # hogs; that every receiver got every value is checked above).
+        assert receivers <= frames <= receivers * VALUES + slack, (frames, elapsed)
         # Every frame ccommd sent reached the bridge or is one the kernel counted as dropped
         # (a veth whose peer's backlog was full on a loaded host); + the kernel's own (ARP, IGMP).
         assert frames <= on_wire + dropped <= frames + 10, (frames, on_wire, dropped)

@@ -159,7 +159,8 @@ class NodePair:
             try:
                 proc.wait(timeout=5)
             except subprocess.TimeoutExpired:
-                bt = run(["gdb", "-p", str(proc.pid), "-batch", "-ex", "thread apply all bt"], check=False).stdout
+                gdb = run(["gdb", "-p", str(proc.pid), "-batch", "-ex", "thread apply all bt"], check=False)
+                bt = gdb.stdout + gdb.stderr[-2000:]  # why gdb could not attach, if it could not
                 print("ccommd %s stuck; log:\n%s\nbacktrace:\n%s" % (node, self.log(node), bt))
                 proc.kill()
                 proc.wait()

@@ -99,26 +99,27 @@ def test_periodic_mode_sends_once_per_period(tmp_path):
     with NodePair(config=str(cfg)) as pair:
         pair.start("control")
         pair.start("planner")
-        writer = pair.spawn("control", "pub", "wheel2_cur", "4.5", "--rate", "1000", "--count", "2500")
+        writer = pair.spawn("control", "pub", "wheel2_cur", "4.5", "--rate", "1000", "--count", "5000")
         time.sleep(0.5)
         t0 = time.time()
         before = peer_stats(pair.stats("control"), "planner")["frames_tx"]
-        rx_before = signal_stats(pair.stats("planner"), "wheel2_cur")["rx"]
+        p0 = pair.stats("planner")
         time.sleep(1.0)
         frames = peer_stats(pair.stats("control"), "planner")["frames_tx"] - before
-        rx = signal_stats(pair.stats("planner"), "wheel2_cur")["rx"] - rx_before
-        elapsed = time.time() - t0  # each stats call itself takes ~0.2 s
+        p1 = pair.stats("planner")
+        elapsed = time.time() - t0  # >= the span between the two reads of control's counter
         # ~200 frames/s (not 1000): never more than one frame per period.
         assert frames <= 200 * elapsed + 5, (frames, elapsed)
-        assert rx <= frames + 5, (rx, frames)  # at most one new value per frame
-        if not SANITIZED:  # a sanitized writer may not keep up 1 kHz: then fewer new values
-            assert frames >= 150, frames
-            # New values in most periods: a writer starved on a loaded machine leaves some
-            # periods without one (then the frame re-sends the old value; 264 of 278 under
-            # two CPU hogs, where it is all of them on a quiet machine).
-            assert 0.8 * frames <= rx, (rx, frames)
-            assert pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh")
-        assert writer.wait(timeout=10) == 0
+        # At most one new value per frame, from one snapshot of the receiver (two nodes'
+        # counters read at different moments would not compare).
+        rx = signal_stats(p1, "wheel2_cur")["rx"] - signal_stats(p0, "wheel2_cur")["rx"]
+        frames_rx = peer_stats(p1, "control")["frames_rx"] - peer_stats(p0, "control")["frames_rx"]
+        assert 0 < rx <= frames_rx + 1, (rx, frames_rx)
+        # It sends on its period (about 200 a second; 129 under two CPU hogs, where a writer
+        # starved by them also leaves periods without a new value: how many is a timing figure).
+        assert frames >= 50, frames
+        assert wait_for(lambda: pair.echo_once("planner", "wheel2_cur") == ("4.5", "fresh"), 5) is not None
+        assert writer.wait(timeout=30) == 0  # 5 s of writes (more on a loaded machine)
         # The writer stopped; ccommd keeps re-sending 4.5 every 5 ms, and it turns stale.
         assert wait_for(lambda: pair.echo_once("planner", "wheel2_cur") == ("4.5", "stale"), 10) is not None
         assert signal_stats(pair.stats("planner"), "wheel0_pos")["rx"] == 0  # never written

@@ -228,8 +228,10 @@ void ReceivePath::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, cons
   if (decoded != wire::DecodeError::kOk) {
     Count(segment_, store::kFramesBad);
     if (decoded == wire::DecodeError::kBadVersion) {  // a board of another ccomm version: say so (supervision)
-      handoffs_.other_version_last.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7], std::memory_order_relaxed);
-      handoffs_.other_version_frames.store(handoffs_.other_version_frames.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      handoffs_.other_version_last.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7],
+                                         std::memory_order_relaxed);
+      handoffs_.other_version_frames.store(handoffs_.other_version_frames.load(std::memory_order_relaxed) + 1,
+                                           std::memory_order_relaxed);
     }
     return;
   }
@@ -287,7 +289,8 @@ void ReceivePath::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, cons
                          view_.SyncedClockOffset(h.sender, now, &sender_offset);
     rx_production_map_ns_ = sender_offset - handoffs_.self_realtime_offset_ns.load(std::memory_order_relaxed);
     if (!rx_production_map_)
-      handoffs_.by_arrival_frames.store(handoffs_.by_arrival_frames.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      handoffs_.by_arrival_frames.store(handoffs_.by_arrival_frames.load(std::memory_order_relaxed) + 1,
+                                        std::memory_order_relaxed);
   }
   if (!ps.alive.exchange(1, std::memory_order_acq_rel))
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());

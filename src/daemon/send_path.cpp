@@ -144,8 +144,8 @@ void SendPath::FlushPeer(uint32_t peer) {
 
 // Inline in CollectSignal: per signal, the common case is one store into an open frame.
 __attribute__((always_inline)) inline void SendPath::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d,
-                                                            uint8_t flags, const store::SlotMeta& m,
-                                                            const void* value, uint64_t now) {
+                                                              uint8_t flags, const store::SlotMeta& m,
+                                                              const void* value, uint64_t now) {
   if (prepared_[id].large) {  // fragments, in frames of their own (SendFragments)
     SendFragments(id, d, flags, m, value, now);
     segment_.stats(id).tx.fetch_add(1, std::memory_order_relaxed);
@@ -208,13 +208,13 @@ __attribute__((noinline, cold)) void SendPath::TxReadFailed(uint32_t id, store::
 }
 
 __attribute__((noinline)) void SendPath::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
-                                                       uint64_t now) {
+                                                         uint64_t now) {
   const uint64_t gone = CatchUp(id, segment_.dir(id), last_sent, newest, now);
   if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
 }
 
 __attribute__((noinline)) void SendPath::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
-                                                         uint64_t word, uint64_t now) {
+                                                           uint64_t word, uint64_t now) {
   store::SlotMeta m;  // AddEntry uses these two of it
   m.value_seq = value_seq;
   m.source_time_ns = source_time_ns;
@@ -271,7 +271,7 @@ void SendPath::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
 // history tap downstream gets every value and nothing is coalesced. Bounded by
 // kStateSlots - 1 reads; a value already overwritten counts as coalesced.
 uint64_t SendPath::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
-                         uint64_t now) {
+                           uint64_t now) {
   const store::StateView& sv = tx_state_[id];
   const uint64_t first = newest - last_sent - 1 >= store::kStateSlots ? newest - (store::kStateSlots - 1) : last_sent + 1;
   uint64_t gone = first - last_sent - 1;

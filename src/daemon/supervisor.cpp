@@ -30,7 +30,8 @@ void Supervisor::Configure(const SystemConfig& cfg, uint32_t self, const std::st
 
 void Supervisor::Prepare(bool adopted) {
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
-  for (uint32_t p = 0; p < table_.node_count(); ++p) segment_.peer(p).alive.store(0);  // a re-adopted segment's are stale
+  // A re-adopted segment's peers were alive for the previous ccommd.
+  for (uint32_t p = 0; p < table_.node_count(); ++p) segment_.peer(p).alive.store(0);
   if (adopted) {
     // Writers that died while this ccommd was down may have left slots half-written.
     size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);

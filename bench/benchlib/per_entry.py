@@ -117,11 +117,11 @@ def section(R, meta, us, ratio_rows):
     if n:
         rows = []
         if n.get("rx_per_entry") is not None:
-            rows.append(("receive: validate + store, per entry (ccommd, `Daemon::HandleFrame` / values received, "
+            rows.append(("receive: validate + store, per entry (ccommd, `ReceivePath::HandleFrame` / values received, "
                          "%s entries per frame)" % _fmt(n.get("entries_per_frame"), 0),
                          n["rx_per_entry"], TARGET_RX_PER_ENTRY))
         if n.get("tx_per_signal") is not None:
-            rows.append(("send: collect + encode, per signal (ccommd, `Daemon::CollectSignal`)",
+            rows.append(("send: collect + encode, per signal (ccommd, `SendPath::CollectSignal`)",
                          n["tx_per_signal"], TARGET_TX_PER_SIGNAL))
             rows.append(("send: the frame's finish + sendto (user part), its share per signal",
                          n.get("tx_frame_share"), None))

@@ -398,12 +398,12 @@ def run_callgrind(ctx, case):
 
 # What a forwarded signal and a frame cost inside ccommd, by function (inclusive Ir per call).
 DAEMON_FUNCTIONS = [
-    ("send: collect one signal from shared memory and encode it", "Daemon::CollectSignal("),
+    ("send: collect one signal from shared memory and encode it", "SendPath::CollectSignal("),
     ("send: add one entry to the frame (wire encoding)", "FrameWriter::Add("),
-    ("send: finish and send one frame (user part of sendto)", "Daemon::FlushPeer("),
-    ("receive: validate one frame and store its entries", "Daemon::HandleFrame("),
+    ("send: finish and send one frame (user part of sendto)", "SendPath::FlushPeer("),
+    ("receive: validate one frame and store its entries", "ReceivePath::HandleFrame("),
     ("receive: one transport receive call (user part of recvfrom)", "RawRecv("),
-    ("supervision tick (every 10 ms)", "Daemon::Supervise("),
+    ("supervision tick (every 10 ms)", "Supervisor::Tick("),
 ]
 
 CLIENT_FUNCTIONS = [

@@ -368,7 +368,7 @@ int PublishStep(ccomm_client* c) {
   bool any = false;
   for (uint32_t w = 0; w < (c->signal_count + 63) / 64 && !any; ++w) any = c->pending_states[w] != 0;
   if (!any) return 0;
-  c->segment.BeginStep();  // ccommd collecting meanwhile refreshes what it took (tx_path.cpp)
+  c->segment.BeginStep();  // ccommd collecting meanwhile refreshes what it took (send_path.cpp, SettleSteps)
   for (uint32_t w = 0; w < (c->signal_count + 63) / 64; ++w) {
     uint64_t bits = c->pending_states[w];
     c->pending_states[w] = 0;

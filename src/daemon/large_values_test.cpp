@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Large values through a real Daemon over loopback UDP (large_values.cpp): fragments
+// Large values through a real Daemon over loopback UDP (send_path.cpp, receive_path.cpp): fragments
 // reassembled into one store write, a lost fragment loses exactly that value (counted),
 // the last whole value stays readable with its own seq and source time, and every kind of
 // bad fragment input is refused and counted without anything half-visible.

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "common/platform.h"
-#include "daemon/daemon.h"
+#include "daemon/ptp_state.h"
 #include "store/freshness.h"
 
 namespace ccomm {
@@ -100,7 +100,7 @@ int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKin
     if (!shared) dests_.push_back(d);
   }
   if (cfg.network.fanout == Fanout::kMulticast && cfg.network.summary_ms != 0 && transport->ops != nullptr) {
-    // Multicast fan-out: once to the summary group, which every node joined (daemon.cpp).
+    // Multicast fan-out: once to the summary group, which every node joined (SendPath::OpenStreams).
     Dest d;
     d.addr = GroupAddressFor(cfg.network, kSummaryGroup, kind);
     d.dest = wire::kDestAll;
@@ -158,7 +158,7 @@ uint32_t SystemViewWriter::Tick(uint64_t now) {
   head.frames_tx = sh->daemon_counters[store::kFramesTx].load(std::memory_order_relaxed);
   head.frames_bad = sh->daemon_counters[store::kFramesBad].load(std::memory_order_relaxed);
   head.socket_drops = sh->daemon_counters[store::kSocketDrops].load(std::memory_order_relaxed);
-  // This board's clock as the supervision tick published it (ptp_clock.cpp).
+  // This board's clock as the supervision tick published it (Supervisor::SuperviseClock).
   const store::PeerStats& me = segment_->peer(self_);
   const uint64_t clock = me.clock_state.load(std::memory_order_acquire);
   const auto state = static_cast<ptp::ClockState>(clock & 0xFF);
@@ -326,21 +326,6 @@ SystemViewWriter::Verdict SystemViewWriter::Receive(const uint8_t* frame, const 
   view_.EndWrite(node);
   vh->summaries_rx.fetch_add(1, std::memory_order_relaxed);
   return Verdict::kApplied;
-}
-
-// The receive path's dispatch for summary frames (rx_path.cpp): the refusals count in the
-// daemon counters of the same meaning as for data frames.
-void Daemon::HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now, const PeerAddress& from) {
-  switch (view_.Receive(buf, h, now, from)) {
-    case SystemViewWriter::Verdict::kApplied: Count(store::kFramesRx, std::memory_order_release); break;
-    case SystemViewWriter::Verdict::kOld: Count(store::kFramesRx); break;  // a duplicate, like data ones
-    case SystemViewWriter::Verdict::kOwn: break;
-    case SystemViewWriter::Verdict::kUnknownSender: Count(store::kFramesUnknownSender); break;
-    case SystemViewWriter::Verdict::kWrongSource: Count(store::kFramesWrongSource); break;
-    case SystemViewWriter::Verdict::kNotForUs: Count(store::kFramesNotForUs); break;
-    case SystemViewWriter::Verdict::kWrongHash: Count(store::kFramesWrongHash); break;
-    case SystemViewWriter::Verdict::kUnknownSignal: Count(store::kEntriesUnknownSignal); break;
-  }
 }
 
 }  // namespace ccomm

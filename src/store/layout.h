@@ -57,7 +57,7 @@ struct alignas(kCacheLine) SegmentHeader {
   std::atomic<uint32_t> tx_sleeping;
   // Batch steps (CCOMM_OPEN_BATCH flushes) store several signals one after another:
   // `steps_active` counts flushes storing right now, `steps_done` counts finished ones,
-  // so ccommd can tell that a step landed while it was collecting (tx_path.cpp).
+  // so ccommd can tell that a step landed while it was collecting (send_path.cpp, SettleSteps).
   std::atomic<uint32_t> steps_active;
   std::atomic<uint32_t> steps_done;
   // Receive-side notification for ccomm_wait(), touched by writers only while someone

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Every state write is either sent or counted coalesced (writes == tx + coalesced), also
 for values written before ccommd sent the first one, and values a writer replaced before
-ccommd looked still leave while the cell's slots hold them (tx_path.cpp, CatchUp): a
+ccommd looked still leave while the cell's slots hold them (send_path.cpp, CatchUp): a
 NO_DOORBELL handle writes twice before ccommd looks (it only looks at its next wake-up,
 within heartbeat_ms): both are sent; then six times: the last four are sent (a state
 keeps four copies), the two before them are counted coalesced, and the planner counts

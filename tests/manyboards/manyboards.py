@@ -274,7 +274,7 @@ def check_counts(r, res, n, nodes, monitor, fanout, sent_before, sent_after, cyc
     # Each cycle's flush leaves as one frame per destination: one to the group (multicast)
     # or one per consumer node (unicast). Frames = values sent of any one signal x that,
     # or fewer: when ccommd ran late, one frame carries two cycles (the older one from the
-    # cells' slots, tx_path.cpp CatchUp); never more, and at most 1 % merged.
+    # cells' slots, send_path.cpp CatchUp); never more, and at most 1 % merged.
     per_cycle, off = {}, []
     for j, name in enumerate(nodes):
         data = sent_after[j]["data"] - sent_before[j]["data"]

@@ -1,15 +1,113 @@
 // SPDX-License-Identifier: Apache-2.0
-// Send path: woken at once by a client's doorbell (event-driven signals), or at the
-// next periodic/heartbeat deadline; batches everything due for one peer into one frame.
+// The send part (send_path.h): woken at once by a client's doorbell (event-driven
+// signals), or at the next periodic/heartbeat deadline; batches everything due for one
+// peer into one frame.
+#include "daemon/send_path.h"
+
 #include <errno.h>
 #include <string.h>
 
 #include "common/platform.h"
-#include "daemon/daemon.h"
+#include "daemon/sd_notify.h"
 
 namespace ccomm {
 
-void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
+int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind kind, bool force_udp,
+                          std::vector<PeerAddress>* groups, std::string* error) {
+  cfg_ = &cfg;
+  self_ = self;
+  heartbeat_ns_ = uint64_t{cfg.network.heartbeat_ms} * 1000000;
+  // main() pings the systemd watchdog only while the send loop advances: an idle loop
+  // must turn at least four times per watchdog interval.
+  const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
+  idle_sleep_ns_ = watchdog_ns && watchdog_ns / 4 < heartbeat_ns_ ? watchdog_ns / 4 : heartbeat_ns_;
+  const size_t n = cfg.signals.size(), m = cfg.nodes.size();
+  const bool multicast = table_.multicast();
+  peers_tx_ = std::vector<PeerTx>(m + 1);  // + the group stream
+  group_tx_ = static_cast<uint32_t>(m);
+  consumers_.assign(n, {});
+  for (size_t i = 0; i < n; ++i) {
+    const SignalConfig& s = cfg.signals[i];
+    if (s.producer != self) continue;
+    for (uint32_t c : s.consumers) {
+      if (c == self) continue;
+      // Multicast fan-out: once, to our group, whatever the number of consumers.
+      if (!multicast) consumers_[i].push_back(c);
+      else if (consumers_[i].empty()) consumers_[i].push_back(group_tx_);
+    }
+    if (!consumers_[i].empty() && s.period_us) periodic_.push_back(static_cast<uint32_t>(i));
+  }
+  const NodeConfig& me = cfg.nodes[self];
+  for (uint32_t p = 0; p < m; ++p) {
+    PeerTx& pt = peers_tx_[p];
+    if (!table_.exchanges(p)) continue;
+    TransportKind pk = force_udp ? TransportKind::kUdp : cfg.nodes[p].transport;
+    if (pk != kind) {
+      *error = "node '" + me.name + "' uses " + (kind == TransportKind::kRaw ? "raw" : "udp") +
+               " but its peer '" + cfg.nodes[p].name + "' uses " +
+               (pk == TransportKind::kRaw ? "raw" : "udp") + ": nodes that exchange signals need the same transport";
+      return -EINVAL;
+    }
+    if (!PeerAddressFor(cfg.network, cfg.nodes[p], kind, &pt.addr)) {
+      *error = "peer '" + cfg.nodes[p].name + "' has no usable ip/multicast for UDP";
+      return -EINVAL;
+    }
+    pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
+    pt.dest = static_cast<uint16_t>(p);
+    pt.sends = !multicast;
+    if (pt.sends) senders_.push_back(p);
+    if (multicast) groups->push_back(GroupAddressFor(cfg.network, p, kind));
+  }
+  if (multicast && !groups->empty()) {
+    // Every node's summary goes to the summary group, which every node with a socket
+    // joins: any board sees the whole system (ccomm stats --all), not only its peers.
+    if (cfg.network.summary_ms != 0) groups->push_back(GroupAddressFor(cfg.network, kSummaryGroup, kind));
+    PeerTx& g = peers_tx_[group_tx_];
+    g.sends = true;
+    g.dest = wire::kDestAll;
+    g.addr = GroupAddressFor(cfg.network, self, kind);
+    g.writer = wire::FrameWriter(g.buf, sizeof g.buf);
+    senders_.push_back(group_tx_);
+  }
+  senders_.shrink_to_fit();
+  return 0;
+}
+
+void SendPath::Prepare(bool adopted) {
+  adopted_ = adopted;
+  prepared_ = table_.signals();
+  const uint32_t n = segment_.signal_count();
+  due_ns_.assign(n, 0);
+  fwd_cursors_.assign(n, store::RingCursor());
+  collected_states_.assign(n, 0);  // RunTx never allocates: a state is taken at most once a round
+  large_pending_.clear();
+  large_pending_.reserve(n);  // at most one entry per signal and round
+  tx_state_.assign(n, store::StateView());
+  tx_signals_.assign(n, TxSignal());
+  for (uint32_t id = 0; id < n; ++id) {
+    const store::SignalDirectoryEntry& d = segment_.dir(id);
+    const PreparedSignals::Signal& ps = prepared_[id];
+    if (ps.is_event && ps.forwarded) {
+      // Resume where the previous ccommd stopped: queued events are still sent.
+      fwd_cursors_[id].next = store::RingForwardCursor(segment_.ring(id));
+    }
+    if (!ps.forwarded) continue;
+    if (!ps.is_event) tx_state_[id] = segment_.state(id);
+    TxSignal& t = tx_signals_[id];
+    t.state = tx_state_[id];
+    t.prefix = ps.prefix;
+    t.tx = &segment_.stats(id).tx;
+    t.fast = !ps.is_event && d.value_bytes == 8 && wire::FrameWriter::IsWordPrefix(ps.prefix) &&
+             consumers_[id].size() == 1 && !ps.large;
+    if (t.fast) t.peer = &peers_tx_[consumers_[id][0]];
+  }
+}
+
+void SendPath::StartPeriods(uint64_t now) {
+  for (uint32_t id : periodic_) due_ns_[id] = now;
+}
+
+void SendPath::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
   PeerTx& p = peers_tx_[peer];
   wire::FrameHeader h;
   h.flags = flags | auth_.frame_flags();  // kFlagAuth: the writer keeps room for the tag
@@ -22,7 +120,7 @@ void Daemon::BeginFrame(uint32_t peer, uint64_t now, uint8_t flags) {
   p.open = true;
 }
 
-void Daemon::FlushPeer(uint32_t peer) {
+void SendPath::FlushPeer(uint32_t peer) {
   PeerTx& p = peers_tx_[peer];
   if (!p.open) return;
   size_t len = p.writer.Finish();
@@ -36,24 +134,24 @@ void Daemon::FlushPeer(uint32_t peer) {
   int r = transport_.Send(p.addr, p.buf, len);
   p.last_tx_ns = platform::MonotonicNs();  // also on failure: a dead link must not busy-loop
   if (r != 0) {
-    Count(store::kSendErrors);
+    Count(segment_, store::kSendErrors);
     return;
   }
-  Count(store::kFramesTx);
+  Count(segment_, store::kFramesTx);
   // Per-peer counts are for unicast streams; a group frame is counted once, in frames_tx.
   if (peer != group_tx_) segment_.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
 }
 
 // Inline in CollectSignal: per signal, the common case is one store into an open frame.
-__attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d,
-                                                            uint8_t flags, const store::SlotMeta& m,
-                                                            const void* value, uint64_t now) {
-  if (large_[id]) {  // fragments, in frames of their own (large_values.cpp)
+__attribute__((always_inline)) inline void SendPath::AddEntry(uint32_t id, const store::SignalDirectoryEntry& d,
+                                                              uint8_t flags, const store::SlotMeta& m,
+                                                              const void* value, uint64_t now) {
+  if (prepared_[id].large) {  // fragments, in frames of their own (SendFragments)
     SendFragments(id, d, flags, m, value, now);
     segment_.stats(id).tx.fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  const uint64_t prefix = tx_prefix_[id];  // the entry's fixed fields, checked and encoded once (PrepareRxTx)
+  const uint64_t prefix = prepared_[id].prefix;  // the entry's fixed fields, checked and encoded once (the table)
   for (uint32_t peer : consumers_[id]) {
     PeerTx& p = peers_tx_[peer];
     if (p.open && p.writer.AddPrepared(prefix, static_cast<uint32_t>(m.value_seq), m.source_time_ns, value,
@@ -74,7 +172,7 @@ __attribute__((always_inline)) inline void Daemon::AddEntry(uint32_t id, const s
 // The common case (TxSignal::fast: a state, one int64/double, one stream) in a small
 // function of its own, so that it saves and restores few registers; every rarer case
 // (no frame open or full, a damaged copy, values to catch up) calls out of line.
-void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
+void SendPath::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   TxSignal& s = tx_signals_[id];
   if (!s.fast) return CollectSignalSlow(id, now, periodic);
   // A local copy: the acquire loads below would make the compiler reload it from `s`.
@@ -105,26 +203,26 @@ void Daemon::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   AddEntryOutOfLine(id, m.value_seq, m.source_time_ns, word, now);  // no frame open, or it is full (counts tx)
 }
 
-__attribute__((noinline, cold)) void Daemon::TxReadFailed(uint32_t id, store::StoreResult r) {
+__attribute__((noinline, cold)) void SendPath::TxReadFailed(uint32_t id, store::StoreResult r) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
 }
 
-__attribute__((noinline)) void Daemon::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
-                                                       uint64_t now) {
+__attribute__((noinline)) void SendPath::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
+                                                         uint64_t now) {
   const uint64_t gone = CatchUp(id, segment_.dir(id), last_sent, newest, now);
   if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
 }
 
-__attribute__((noinline)) void Daemon::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
-                                                         uint64_t word, uint64_t now) {
+__attribute__((noinline)) void SendPath::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
+                                                           uint64_t word, uint64_t now) {
   store::SlotMeta m;  // AddEntry uses these two of it
   m.value_seq = value_seq;
   m.source_time_ns = source_time_ns;
   AddEntry(id, segment_.dir(id), 0, m, &word, now);
 }
 
-void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
-  if (large_[id] && !sending_large_) {  // sent after the round's small entries
+void SendPath::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
+  if (prepared_[id].large && !sending_large_) {  // sent after the round's small entries
     large_pending_.push_back({id, periodic});
     return;
   }
@@ -145,7 +243,7 @@ void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
     store::SetRingForwardCursor(ring, cur.next);
     return;
   }
-  const store::StateView& sv = tx_state_[id];  // resolved once (PrepareRxTx)
+  const store::StateView& sv = tx_state_[id];  // resolved once (Prepare)
   uint64_t version = store::StateVersion(sv);
   // Event-driven: send each new value once. Periodic: send the last value every period.
   if (version == 0 || (!periodic && version == store::StateForwarded(sv))) return;
@@ -172,8 +270,8 @@ void Daemon::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
 // (kStateSlots copies): they go out first, in order, in the same frame, so a recorder or
 // history tap downstream gets every value and nothing is coalesced. Bounded by
 // kStateSlots - 1 reads; a value already overwritten counts as coalesced.
-uint64_t Daemon::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
-                         uint64_t now) {
+uint64_t SendPath::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
+                           uint64_t now) {
   const store::StateView& sv = tx_state_[id];
   const uint64_t first = newest - last_sent - 1 >= store::kStateSlots ? newest - (store::kStateSlots - 1) : last_sent + 1;
   uint64_t gone = first - last_sent - 1;
@@ -196,7 +294,7 @@ uint64_t Daemon::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint
 // state it took to the frames still open (after the older ones, see CatchUp): each step's
 // outputs leave together and in order, whatever the timing of ccommd against the writers.
 // The common case costs two loads.
-void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
+void SendPath::SettleSteps(uint32_t steps_before, uint64_t now) {
   store::SegmentHeader* h = segment_.header();
   for (int pass = 0; pass < 8; ++pass) {
     for (int spin = 0; spin < 4096 && h->steps_active.load(std::memory_order_acquire) != 0; ++spin)
@@ -224,16 +322,43 @@ void Daemon::SettleSteps(uint32_t steps_before, uint64_t now) {
   }
 }
 
-void Daemon::RunTx() {
+void SendPath::SendLargeValues(uint64_t now) {
+  sending_large_ = true;  // CollectSignal sends now instead of queueing
+  for (const LargePending& p : large_pending_) CollectSignal(p.id, now, p.periodic);
+  sending_large_ = false;
+  large_pending_.clear();
+}
+
+void SendPath::SendFragments(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
+                             const store::SlotMeta& m, const void* value, uint64_t now) {
+  const size_t part = wire::FrameWriter::MaxFragmentPart(auth_.enabled());
+  const uint8_t* bytes = static_cast<const uint8_t*>(value);
+  for (uint32_t peer : consumers_[id]) {
+    PeerTx& p = peers_tx_[peer];
+    FlushPeer(peer);  // the round's small entries leave first, in their own frame
+    for (size_t off = 0; off < d.value_bytes; off += part) {
+      const size_t len = d.value_bytes - off < part ? d.value_bytes - off : part;
+      BeginFrame(peer, now, 0);
+      // Cannot fail: the arguments follow the signal's directory entry, and a part of
+      // MaxFragmentPart bytes fits an empty frame (with room for the tag).
+      p.writer.AddFragment(static_cast<uint16_t>(id), d.type, flags, static_cast<uint16_t>(d.count),
+                           static_cast<uint32_t>(m.value_seq), m.source_time_ns, static_cast<uint32_t>(off),
+                           bytes + off, len);
+      FlushPeer(peer);
+    }
+  }
+}
+
+void SendPath::RunTx() {
   const NodeConfig& self = cfg_->nodes[self_];
-  EnterIoThread("send");
   store::SegmentHeader* h = segment_.header();
   std::atomic<uint64_t>* dirty = segment_.dirty_words();
-  const uint32_t words = (segment_.signal_count() + 63) / 64;
+  const uint32_t signal_count = segment_.signal_count();
+  const uint32_t words = (signal_count + 63) / 64;
   const uint64_t spin_ns = uint64_t{self.realtime.spin_us} * 1000;
 
-  while (running_.load(std::memory_order_relaxed)) {
-    tx_loops_.fetch_add(1, std::memory_order_relaxed);
+  while (handoffs_.running.load(std::memory_order_relaxed)) {
+    handoffs_.tx_loops.fetch_add(1, std::memory_order_relaxed);
     uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
     uint64_t now = platform::MonotonicNs();
     const uint32_t steps_before = h->steps_done.load(std::memory_order_acquire);
@@ -245,7 +370,7 @@ void Daemon::RunTx() {
         bits &= bits - 1;
         uint32_t id = w * 64 + b;
         // Periodic signals leave on their period only (not early with another write).
-        if (id < segment_.signal_count() && !consumers_[id].empty() && !cfg_->signals[id].period_us)
+        if (id < signal_count && !consumers_[id].empty() && !cfg_->signals[id].period_us)
           CollectSignal(id, now, false);
       }
     }
@@ -289,7 +414,7 @@ void Daemon::RunTx() {
     h->tx_sleeping.store(1, std::memory_order_seq_cst);
     platform::FutexWait(&h->tx_doorbell, snapshot, static_cast<int64_t>(next_deadline - now));
     h->tx_sleeping.store(0, std::memory_order_relaxed);
-    Count(store::kTxWakeups);
+    Count(segment_, store::kTxWakeups);
   }
 }
 

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// Receive path: validate a frame completely, account it to its peer, store its entries.
-// Anything malformed or unexpected is counted and dropped; nothing is half-applied.
+// The receive part (receive_path.h): validate a frame completely, account it to its
+// peer, store its entries. Anything malformed or unexpected is counted and dropped;
+// nothing is half-applied.
+#include "daemon/receive_path.h"
+
 #include <errno.h>
 #include <time.h>
 
 #include "common/platform.h"
-#include "daemon/daemon.h"
 
 namespace ccomm {
 
@@ -22,7 +24,55 @@ constexpr int32_t kResyncDistance = 1024;
 
 }  // namespace
 
-void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
+void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind kind, int recv_timeout_ms) {
+  cfg_ = &cfg;
+  self_ = self;
+  recv_timeout_ms_ = recv_timeout_ms;
+  peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
+  const uint32_t n = segment_.signal_count(), m = static_cast<uint32_t>(cfg.nodes.size());
+  peers_rx_.assign(m, PeerRx());
+  replay_.assign(m, auth::ReplayWindow());
+  for (uint32_t p = 0; p < m; ++p) {
+    // UDP frames must come from the peer's own address (rule 2); raw frames carry no
+    // address worth checking (any station can send any source MAC).
+    if (table_.exchanges(p) && kind == TransportKind::kUdp && !cfg.nodes[p].ip.empty())
+      platform::ParseIpv4(cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
+  }
+  history_.assign(n, store::RingView());
+  rx_signals_.assign(n, RxSignal());
+  rx_known_.assign(n, wire::KnownEntry());
+  large_rx_.clear();
+  large_rx_.resize(n);
+  for (uint32_t id = 0; id < n; ++id) {
+    history_[id] = segment_.history(id);
+    const PreparedSignals::Signal& ps = table_.signal(id);
+    if (!ps.consumed_here) continue;
+    const store::SignalDirectoryEntry& d = segment_.dir(id);
+    if (ps.large) {
+      LargeRx& l = large_rx_[id];
+      l.buf.assign(d.value_bytes, 0);
+      // Periodic states are sent again unchanged each period: not duplicates.
+      l.reasm.Init(l.buf.data(), d.value_bytes, d.period_us != 0 && !ps.is_event);
+    }
+    RxSignal& r = rx_signals_[id];
+    r.prefix = ps.prefix;
+    rx_known_[id] = wire::MakeKnownEntry(ps.prefix, d.type, d.value_bytes);
+    r.producer = ps.producer;
+    r.is_event = ps.is_event;
+    r.count_gaps = ps.is_event || cfg.signals[id].period_us == 0;
+    r.one_word = d.count == 1 && d.value_bytes == 8;
+    r.state_word = r.one_word && !ps.is_event;
+    r.history = history_[id].ring != nullptr;
+    r.by_production = !ps.is_event && cfg.signals[id].stale_by == StaleBy::kProduction;
+    any_by_production_ |= r.by_production;
+    r.entry_size = static_cast<uint32_t>(wire::kEntryHeaderSize + ((d.value_bytes + 7u) & ~7u));
+    if (ps.is_event) r.ring = segment_.ring(id);
+    else r.state = segment_.state(id);
+    r.stats = &segment_.stats(id);
+  }
+}
+
+void ReceivePath::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
   store::PeerStats& ps = segment_.peer(h.sender);
   PeerRx& pr = peers_rx_[h.sender];
   FrameStream& fs = pr.stream[h.dest == wire::kDestAll ? 1 : 0];
@@ -67,7 +117,7 @@ void Daemon::AccountFrame(const wire::FrameHeader& h, uint64_t now) {
   if (h.send_time_ns > fs.last_send_ns) fs.last_send_ns = h.send_time_ns;
 }
 
-uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
+uint64_t ReceivePath::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
   SignalRx& r = rx_signals_[id].last;
   if (!r.seen) {  // first value, or after the producer restarted: numbering goes on
     r.seen = true;
@@ -96,21 +146,21 @@ uint64_t Daemon::AcceptValue(uint32_t id, uint32_t seq, bool count_gaps) {
 }
 
 // An entry that is not a known one of this sender's: a part of a large value
-// (large_values.cpp), or one to count and skip. True if it completed a stored value.
-bool Daemon::HandleOtherEntry(const wire::FrameHeader& h, const uint8_t* entry, uint64_t now) {
+// (HandleFragment), or one to count and skip. True if it completed a stored value.
+bool ReceivePath::HandleOtherEntry(const wire::FrameHeader& h, const uint8_t* entry, uint64_t now) {
   const wire::EntryRef e{entry};
   if (e.flags() & wire::kEntryFragment) return HandleFragment(h, e, now);
   CountBadEntry(e.signal(), h);
   return false;
 }
 
-void Daemon::AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
+void ReceivePath::AppendHistory(uint32_t id, const void* value, uint64_t seq, uint64_t source_ns, uint64_t now) {
   store::RingWrite(history_[id], value, seq, source_ns, now);
 }
 
 // Any other signal of a known entry: its value converted to host order, then stored.
 // False if the store refused it (an event ring full of unread values: counted).
-bool Daemon::StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::SlotMeta& meta) {
+bool ReceivePath::StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::SlotMeta& meta) {
   const wire::EntryRef e{entry};
   const uint8_t* wire_value = entry + wire::kEntryHeaderSize;  // its prefix says: no fragment
   const void* value = rx_value_;
@@ -136,7 +186,7 @@ bool Daemon::StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::S
 
 // One entry of a signal this node takes from the frame's sender (its prefix matched):
 // rule 6, then the store. Inline in HandleFrame's loops. True if a value was stored.
-__attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, const uint8_t* entry, uint64_t now) {
+__attribute__((always_inline)) inline bool ReceivePath::ApplyEntry(RxSignal& rs, const uint8_t* entry, uint64_t now) {
   const wire::EntryRef e{entry};
   // Rule 6; the next value in order (the common case) inline, the rest in AcceptValue.
   // Gaps mean lost values only where every value is sent (events, event-driven states).
@@ -171,41 +221,43 @@ __attribute__((always_inline)) inline bool Daemon::ApplyEntry(RxSignal& rs, cons
   return true;
 }
 
-void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
+void ReceivePath::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
   wire::FrameHeader h;
   // One validation pass: entries of the signals this node takes cost one compare each.
   const wire::DecodeError decoded = wire::DecodeFrame(buf, len, &h, rx_known_.data(), rx_known_.size());
   if (decoded != wire::DecodeError::kOk) {
-    Count(store::kFramesBad);
+    Count(segment_, store::kFramesBad);
     if (decoded == wire::DecodeError::kBadVersion) {  // a board of another ccomm version: say so (supervision)
-      other_version_last_.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7], std::memory_order_relaxed);
-      other_version_frames_.store(other_version_frames_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      handoffs_.other_version_last.store(uint32_t{buf[4]} << 16 | uint32_t{buf[6]} << 8 | buf[7],
+                                         std::memory_order_relaxed);
+      handoffs_.other_version_frames.store(handoffs_.other_version_frames.load(std::memory_order_relaxed) + 1,
+                                           std::memory_order_relaxed);
     }
     return;
   }
   // Authenticate before any field is trusted (the decode above only checked bounds).
   if (!auth_.Accept(buf, len, h.flags)) {
-    Count(store::kFramesAuthFailed);
+    Count(segment_, store::kFramesAuthFailed);
     return;
   }
   if (h.flags & wire::kFlagSummary) {  // a node summary, from any node: not a data frame
     HandleSummary(buf, h, now, from);
     return;
   }
-  if (h.sender >= peers_rx_.size() || h.sender == self_ || !peers_tx_[h.sender].active) {
-    Count(store::kFramesUnknownSender);
+  if (h.sender >= peers_rx_.size() || h.sender == self_ || !table_.exchanges(h.sender)) {
+    Count(segment_, store::kFramesUnknownSender);
     return;
   }
   if (peers_rx_[h.sender].ipv4 && from.ipv4 != peers_rx_[h.sender].ipv4) {
-    Count(store::kFramesWrongSource);  // claims a configured node, sent from elsewhere
+    Count(segment_, store::kFramesWrongSource);  // claims a configured node, sent from elsewhere
     return;
   }
   if (h.dest != self_ && h.dest != wire::kDestAll) {
-    Count(store::kFramesNotForUs);  // a broadcast frame meant for another node
+    Count(segment_, store::kFramesNotForUs);  // a broadcast frame meant for another node
     return;
   }
   if (h.config_hash != cfg_->hash) {
-    Count(store::kFramesWrongHash);
+    Count(segment_, store::kFramesWrongHash);
     if (!wrong_hash_logged_) {  // once: the counter tells how often
       wrong_hash_logged_ = true;
       Log(LogLevel::kWarning, "frames from node '%s' carry config hash %08x, ours is %08x: the boards run "
@@ -216,7 +268,7 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   }
   if (auth_.enabled() &&
       replay_[h.sender].Check(h.seq, h.send_time_ns, now, peer_timeout_ns_) == auth::ReplayVerdict::kReplay) {
-    Count(store::kFramesReplayed);  // an authentic frame seen before (or older than the window)
+    Count(segment_, store::kFramesReplayed);  // an authentic frame seen before (or older than the window)
     return;
   }
   store::PeerStats& ps = segment_.peer(h.sender);
@@ -233,11 +285,12 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   AccountQueueDelay(ps, pr.clock, now - arrived);
   if (any_by_production_) {  // the sender's clock onto ours, through the common time base
     int64_t sender_offset = 0;
-    rx_production_map_ = self_clock_synced_.load(std::memory_order_acquire) != 0 &&
+    rx_production_map_ = handoffs_.self_clock_synced.load(std::memory_order_acquire) != 0 &&
                          view_.SyncedClockOffset(h.sender, now, &sender_offset);
-    rx_production_map_ns_ = sender_offset - self_realtime_offset_ns_.load(std::memory_order_relaxed);
+    rx_production_map_ns_ = sender_offset - handoffs_.self_realtime_offset_ns.load(std::memory_order_relaxed);
     if (!rx_production_map_)
-      by_arrival_frames_.store(by_arrival_frames_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      handoffs_.by_arrival_frames.store(handoffs_.by_arrival_frames.load(std::memory_order_relaxed) + 1,
+                                        std::memory_order_relaxed);
   }
   if (!ps.alive.exchange(1, std::memory_order_acq_rel))
     Log(LogLevel::kNotice, "peer '%s' up", cfg_->nodes[h.sender].name.c_str());
@@ -276,19 +329,118 @@ void Daemon::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const Pee
   }
   // Counted last, with release: whoever sees a frame in frames_rx (acquire) also sees
   // all its entries applied (tests and `ccomm stats` snapshots rely on that).
-  Count(store::kFramesRx, std::memory_order_release);
+  Count(segment_, store::kFramesRx, std::memory_order_release);
   if (stored) {
     store::PublishedStoresFence();  // the single-writer stores before the rx_waiters load
     segment_.NotifyRx();
   }
 }
 
-void Daemon::RunRx() {
-  EnterIoThread("receive");
-  while (running_.load(std::memory_order_relaxed)) {
-    rx_loops_.fetch_add(1, std::memory_order_relaxed);
+// An entry that is not one this node takes from this sender: says why, in the counters
+// (the checks and their order as before the fast path; a group frame carries every
+// consumer's entries, so skipping those of signals not consumed here is normal).
+void ReceivePath::CountBadEntry(uint16_t signal, const wire::FrameHeader& h) {
+  if (signal >= segment_.signal_count()) {
+    Count(segment_, store::kEntriesUnknownSignal);
+    return;
+  }
+  const PreparedSignals::Signal& s = table_.signal(signal);
+  if (s.producer != h.sender) {
+    Count(segment_, store::kFramesNotForUs);  // the sender does not produce it: not a valid entry
+    return;
+  }
+  if (!s.consumed_here) {
+    if (h.dest != wire::kDestAll || !table_.multicast()) Count(segment_, store::kFramesNotForUs);
+    return;
+  }
+  Count(segment_, store::kEntriesWrongType);  // consumed here from this sender: type, count or kind differ
+}
+
+// Large values (docs/protocol.md, "Large values"): the fragments of a value are
+// reassembled in its preallocated buffer and stored in one write once whole, so readers
+// only ever see whole values.
+bool ReceivePath::HandleFragment(const wire::FrameHeader& h, const wire::EntryRef& ref, uint64_t now) {
+  wire::EntryView e;
+  ref.Read(&e);
+  // Not a signal this node takes from this sender: counted as any such entry.
+  if (e.signal >= segment_.signal_count() || cfg_->signals[e.signal].producer != h.sender ||
+      !(segment_.dir(e.signal).flags & store::kSigConsumedHere)) {
+    CountBadEntry(e.signal, h);
+    return false;
+  }
+  const store::SignalDirectoryEntry& d = segment_.dir(e.signal);
+  const SignalConfig& sc = cfg_->signals[e.signal];
+  store::SignalStats& ss = segment_.stats(e.signal);
+  const bool is_event = (d.flags & store::kSigEvent) != 0;
+  // A fragment of a signal that travels whole, or that disagrees with its configuration.
+  if (!table_.signal(e.signal).large || e.type != d.type || e.count != d.count ||
+      ((e.flags & wire::kEntryEvent) != 0) != is_event) {
+    Count(segment_, store::kEntriesWrongType);
+    ss.fragments_refused.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  LargeRx& l = large_rx_[e.signal];
+  uint32_t abandoned = 0;
+  const wire::FragmentResult r = l.reasm.Accept(e, &abandoned);
+  if (abandoned) ss.values_incomplete.fetch_add(abandoned, std::memory_order_relaxed);
+  if (wire::IsRefusal(r)) {
+    ss.fragments_refused.fetch_add(1, std::memory_order_relaxed);
+    if (!large_refusal_logged_) {  // once: the counter tells how often
+      large_refusal_logged_ = true;
+      Log(LogLevel::kWarning, "signal '%s' from node '%s': fragment refused (%s, seq %u, offset %u); "
+          "further refusals are only counted (fragments_refused in ccomm stats)",
+          sc.name.c_str(), cfg_->nodes[h.sender].name.c_str(), wire::FragmentResultName(r), e.seq, e.offset);
+    }
+    return false;
+  }
+  if (r != wire::FragmentResult::kComplete) return false;
+  // The whole value: rule 6 as for any entry. Values abandoned above are missing from
+  // the sequence and counted as lost here, once each.
+  const uint64_t value_seq = AcceptValue(e.signal, l.reasm.seq(), is_event || sc.period_us == 0);
+  if (value_seq == 0) return false;
+  if (is_event) {
+    if (store::RingWrite(segment_.ring(e.signal), l.reasm.value(), value_seq, l.reasm.source_time_ns(), now) !=
+        store::StoreResult::kOk) {
+      ss.write_errors.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+  } else {  // ccommd is the only writer of a received state (HandleFrame fences after the frame)
+    store::StateWriteSingle(segment_.state(e.signal), l.reasm.value(),
+                            store::SlotMeta{value_seq, l.reasm.source_time_ns(), now});
+    if (rx_signals_[e.signal].history)
+      AppendHistory(e.signal, l.reasm.value(), value_seq, l.reasm.source_time_ns(), now);
+  }
+  ss.rx.fetch_add(1, std::memory_order_relaxed);
+  ss.last_rx_ns.store(now, std::memory_order_relaxed);
+  return true;
+}
+
+void ReceivePath::ResetReassemblers(uint32_t producer) {
+  for (size_t i = 0; i < large_rx_.size(); ++i)
+    if (cfg_->signals[i].producer == producer && !large_rx_[i].buf.empty()) large_rx_[i].reasm.Reset();
+}
+
+// Node summaries (system_view_writer.h): the refusals count in the daemon counters of the
+// same meaning as for data frames.
+void ReceivePath::HandleSummary(const uint8_t* buf, const wire::FrameHeader& h, uint64_t now,
+                                const PeerAddress& from) {
+  switch (view_.Receive(buf, h, now, from)) {
+    case SystemViewWriter::Verdict::kApplied: Count(segment_, store::kFramesRx, std::memory_order_release); break;
+    case SystemViewWriter::Verdict::kOld: Count(segment_, store::kFramesRx); break;  // a duplicate, like data ones
+    case SystemViewWriter::Verdict::kOwn: break;
+    case SystemViewWriter::Verdict::kUnknownSender: Count(segment_, store::kFramesUnknownSender); break;
+    case SystemViewWriter::Verdict::kWrongSource: Count(segment_, store::kFramesWrongSource); break;
+    case SystemViewWriter::Verdict::kNotForUs: Count(segment_, store::kFramesNotForUs); break;
+    case SystemViewWriter::Verdict::kWrongHash: Count(segment_, store::kFramesWrongHash); break;
+    case SystemViewWriter::Verdict::kUnknownSignal: Count(segment_, store::kEntriesUnknownSignal); break;
+  }
+}
+
+void ReceivePath::RunRx() {
+  while (handoffs_.running.load(std::memory_order_relaxed)) {
+    handoffs_.rx_loops.fetch_add(1, std::memory_order_relaxed);
     if (!transport_.ops) {  // local-only node: nothing to receive
-      platform::SleepNs(uint64_t{static_cast<uint32_t>(opt_.recv_timeout_ms)} * 1000 * 1000);
+      platform::SleepNs(uint64_t{static_cast<uint32_t>(recv_timeout_ms_)} * 1000 * 1000);
       continue;
     }
     PeerAddress from;
@@ -297,8 +449,8 @@ void Daemon::RunRx() {
       HandleFrame(rx_buf_, static_cast<size_t>(n), platform::MonotonicNs(), from);
     } else if (n < 0) {
       const bool bad_frame = n == -EMSGSIZE || n == -ENODATA;  // oversized or empty: junk, not a fault
-      if (bad_frame) Count(store::kFramesBad);
-      else Count(store::kRecvErrors);
+      if (bad_frame) Count(segment_, store::kFramesBad);
+      else Count(segment_, store::kRecvErrors);
       if (!bad_frame) {
         // e.g. ENETDOWN while the link is down: do not spin.
         platform::SleepNs(10 * 1000 * 1000);

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: Apache-2.0
+// ccommd's send part: the send thread's state and what it does (send_path.cpp). Woken
+// at once by a client's doorbell (event-driven signals) or at its next periodic or
+// heartbeat deadline, RunTx() collects what changed or is due from the segment and
+// batches it into one frame per stream; values too large for a frame follow as
+// fragments. Everything is allocated at start-up; after Daemon::Start() only the send
+// thread touches this object (what it shares: thread_handoffs.h).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config/config.h"
+#include "daemon/auth.h"
+#include "daemon/prepared_signals.h"
+#include "daemon/thread_handoffs.h"
+#include "daemon/transport.h"
+#include "store/segment.h"
+#include "wire/wire.h"
+
+namespace ccomm {
+
+class SendPath {
+ public:
+  SendPath(store::Segment& segment, Transport& transport, const auth::FrameAuth& auth, ThreadHandoffs& handoffs,
+           const PreparedSignals& table)
+      : segment_(segment), transport_(transport), auth_(auth), handoffs_(handoffs), table_(table) {}
+  SendPath(const SendPath&) = delete;
+  SendPath& operator=(const SendPath&) = delete;
+
+  /// Start-up, from the configuration (before the segment or the socket exists): a stream
+  /// to each node this one exchanges signals with, or with fanout="multicast" the one to
+  /// its group, addressed for transport `kind`; which signals go out on which; the groups
+  /// this node receives, appended to `groups`. 0, or -EINVAL with `error` (a peer on
+  /// another transport, or without a usable address).
+  int OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind kind, bool force_udp,
+                  std::vector<PeerAddress>* groups, std::string* error);
+  /// Start-up, once the segment exists and the table is resolved: the signals' send
+  /// records, event cursors (resumed in a re-adopted segment), buffers.
+  void Prepare(bool adopted);
+  /// Last of start-up: the periodic signals are due from `now` on.
+  void StartPeriods(uint64_t now);
+  /// The send thread's body; returns once ThreadHandoffs::running is false.
+  void RunTx();
+
+ private:
+  // A frame stream this node sends: to one peer (unicast fan-out), or, with
+  // fanout="multicast", the one stream to this node's group (index group_tx_).
+  struct PeerTx {
+    bool sends = false;         // frames go out on this stream (data and heartbeats)
+    uint16_t dest = 0;          // header dest: the peer's id, or wire::kDestAll for the group
+    PeerAddress addr;
+    uint32_t seq = 0;
+    uint64_t last_tx_ns = 0;
+    wire::FrameWriter writer{nullptr, 0};
+    bool open = false;          // writer holds a begun frame
+    uint8_t buf[wire::kMaxFrameSize];
+  };
+  // What the send path needs of a signal in one record (one index, one cache line); `fast`:
+  // the common case, a forwarded state with one int64/double value going out on one
+  // stream (a peer or the group), not in fragments.
+  struct alignas(64) TxSignal {
+    store::StateView state;
+    uint64_t prefix = 0;                         // its entries' first 8 bytes
+    std::atomic<uint64_t>* tx = nullptr;         // its `tx` counter (this thread: only writer)
+    uint64_t last_seq = 0;                       // last value_seq sent (any path)
+    PeerTx* peer = nullptr;                      // fast: the one stream (peers_tx_ is never resized)
+    bool fast = false;                           // the case above: CollectSignal's fast path
+  };
+  struct LargePending {  // a large value due this round (sent after the small entries)
+    uint32_t id;
+    bool periodic;
+  };
+
+  void CollectSignal(uint32_t id, uint64_t now, bool periodic);
+  void CollectSignalSlow(uint32_t id, uint64_t now, bool periodic);  // all but TxSignal::fast
+  void TxReadFailed(uint32_t id, store::StoreResult r);
+  void CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest, uint64_t now);
+  void AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns, uint64_t word, uint64_t now);
+  void SettleSteps(uint32_t steps_before, uint64_t now);
+  /// Adds the values of state `id` written after `last_sent` and before the newest one
+  /// (value_seq `newest`) that its slots still hold, oldest first; returns how many of
+  /// them are gone (replaced before ccommd took them: coalesced).
+  uint64_t CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
+                   uint64_t now);
+  void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
+                const void* value, uint64_t now);
+  void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
+  void FlushPeer(uint32_t peer);
+  // Large values (docs/protocol.md, "Large values"): one fragment entry per frame, after
+  // the round's small entries.
+  void SendLargeValues(uint64_t now);
+  void SendFragments(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
+                     const void* value, uint64_t now);
+
+  // Shared with the other parts (Daemon owns them).
+  store::Segment& segment_;
+  Transport& transport_;
+  const auth::FrameAuth& auth_;
+  ThreadHandoffs& handoffs_;
+  const PreparedSignals& table_;
+  const SystemConfig* cfg_ = nullptr;
+  uint32_t self_ = 0;
+  bool adopted_ = false;                          // a re-adopted segment: the last value sent is unknown
+  uint64_t heartbeat_ns_ = 0;
+  uint64_t idle_sleep_ns_ = 0;                    // longest sleep of an idle send loop
+
+  // Preallocated at start-up.
+  const PreparedSignals::Signal* prepared_ = nullptr;  // table_.signals()
+  std::vector<PeerTx> peers_tx_;                  // [node id] and, last, the group stream
+  std::vector<uint32_t> senders_;                 // indices of peers_tx_ that send
+  uint32_t group_tx_ = 0;                         // index of the group stream (multicast fan-out)
+  std::vector<std::vector<uint32_t>> consumers_;  // signal -> the streams (peers_tx_) it goes out on
+  std::vector<uint32_t> periodic_;                // forwarded periodic signal ids
+  std::vector<uint64_t> due_ns_;                  // signal -> next periodic send
+  std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
+  std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
+  std::vector<TxSignal> tx_signals_;              // signal -> its send record
+  std::vector<uint32_t> collected_states_;        // state signals taken this send round: [0, collected_count_)
+  uint32_t collected_count_ = 0;
+  std::vector<LargePending> large_pending_;       // large values due this send round
+  bool sending_large_ = false;
+  alignas(8) uint8_t tx_value_[kMaxValueBytes];
+  alignas(8) uint8_t tx_older_[kMaxValueBytes];  // CatchUp's copy of an older value
+};
+
+}  // namespace ccomm

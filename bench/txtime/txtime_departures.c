@@ -47,12 +47,13 @@ int main(int argc, char** argv) {
     fprintf(stderr, "txtime_departures: no interface %s, or no cycle\n", argv[1]);
     return 2;
   }
-  int fd = socket(AF_PACKET, SOCK_RAW, htons((uint16_t)ethertype));
+  // ETH_P_ALL: a packet socket sees outgoing frames only as a tap of every protocol.
+  int fd = socket(AF_PACKET, SOCK_RAW, htons(ETH_P_ALL));
   if (fd < 0) {
     perror("socket(AF_PACKET)");
     return 1;
   }
-  struct sockaddr_ll sll = {.sll_family = AF_PACKET, .sll_protocol = htons((uint16_t)ethertype), .sll_ifindex = (int)ifindex};
+  struct sockaddr_ll sll = {.sll_family = AF_PACKET, .sll_protocol = htons(ETH_P_ALL), .sll_ifindex = (int)ifindex};
   if (bind(fd, (struct sockaddr*)&sll, sizeof sll)) {
     perror("bind");
     return 1;
@@ -84,7 +85,9 @@ int main(int argc, char** argv) {
       break;
     }
     // Outgoing ccomm data frames: Ethernet header, then version, flags (heartbeat 1, summary 4).
-    if (from.sll_pkttype != PACKET_OUTGOING || len < 14 + 2 || (buf[14 + 1] & 0x05)) continue;
+    if (from.sll_pkttype != PACKET_OUTGOING || len < 14 + 2 || ((buf[12] << 8) | buf[13]) != ethertype ||
+        (buf[14 + 1] & 0x05))
+      continue;
     for (struct cmsghdr* c = CMSG_FIRSTHDR(&m); c; c = CMSG_NXTHDR(&m, c)) {
       if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SO_TIMESTAMPNS) continue;
       struct timespec ts;

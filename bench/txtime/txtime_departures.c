@@ -84,9 +84,10 @@ int main(int argc, char** argv) {
       perror("recvmsg");
       break;
     }
-    // Outgoing ccomm data frames: Ethernet header, then version, flags (heartbeat 1, summary 4).
-    if (from.sll_pkttype != PACKET_OUTGOING || len < 14 + 2 || ((buf[12] << 8) | buf[13]) != ethertype ||
-        (buf[14 + 1] & 0x05))
+    // Outgoing ccomm data frames: Ethernet header, then magic "CCMW", version, flags
+    // (heartbeat 1, summary 4).
+    if (from.sll_pkttype != PACKET_OUTGOING || len < 14 + 6 || ((buf[12] << 8) | buf[13]) != ethertype ||
+        (buf[14 + 5] & 0x05))
       continue;
     for (struct cmsghdr* c = CMSG_FIRSTHDR(&m); c; c = CMSG_NXTHDR(&m, c)) {
       if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SO_TIMESTAMPNS) continue;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Send on the cycle in ccommd (send_cycle.h): what the hooks in daemon.cpp (start-up),
 // ptp_clock.cpp (supervision) and tx_path.cpp (the send thread) call.
+#include <errno.h>
 #include <string.h>
 
 #include "common/platform.h"

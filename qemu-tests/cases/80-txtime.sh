@@ -15,8 +15,8 @@ need_ccomm
 
 SECONDS_PER_MODE=${QT_TXTIME_SECONDS:-20}
 CYCLE_US=10000 PHASE_US=2000
-LEAD_US=${QT_TXTIME_LEAD_US:-3000}     # emulated boards wake late: a generous lead
-DELTA_NS=${QT_TXTIME_DELTA_NS:-1000000} # ETF's delta: its own wake-up latency here
+LEAD_US=${QT_TXTIME_LEAD_US:-5000}     # emulated boards wake late: a generous lead
+DELTA_NS=${QT_TXTIME_DELTA_NS:-2000000} # ETF's delta: its own wake-up latency here
 CFG=/etc/ccomm/signals.xml
 DEP=/usr/libexec/ccomm/bench/txtime_departures
 OUT=$QT_WORK/txtime.json
@@ -44,12 +44,20 @@ restart() {
 	fresh() { vm planner 'ccomm echo txt_cycle --once' | grep -q fresh; }
 	wait_until 30 fresh
 }
-measure() {  # $1: mode name; prints the departures line
-	local line
+counters() { vm control 'ccomm stats --json' | jget "' '.join(str(d['counters'].get(k, 0)) for k in ('cycle_rounds', 'cycle_late', 'cycle_etf_drops', 'send_errors'))"; }
+measure() {  # $1: mode name; prints the departures line, more percentiles, the round counters
+	local line before after
+	before=$(counters)
 	line=$(vm --timeout $((SECONDS_PER_MODE + 30)) control \
 		"$DEP eth0 0x88B5 $CYCLE_US $PHASE_US mono $SECONDS_PER_MODE /run/ccq-txtime-$1.samples")
+	after=$(counters)
 	note "departures, $1: $line"
-	note "control: $(vm control 'ccomm stats | grep -E "^(send cycle|daemon):"' | tr '\n' ' ')"
+	vm control "cat /run/ccq-txtime-$1.samples" >"$QT_WORK/txtime-$1.samples"
+	note "departures, $1, percentiles p1 p5 p25 p50 p75 p95 p99 (us): $(sort -n "$QT_WORK/txtime-$1.samples" |
+		awk '{ v[n++] = $1 } END { split("1 5 25 50 75 95 99", p, " "); for (i = 1; i <= 7; i++) printf "%.0f ", v[int(n * p[i] / 100)] / 1000 }')"
+	note "control, during the $1 run: rounds, late, ETF drops, send errors: $(echo "$before $after" |
+		awk '{ printf "%d %d %d %d", $5 - $1, $6 - $2, $7 - $3, $8 - $4 }')"
+	note "control: $(vm control 'ccomm stats | grep -E "^send cycle:"')"
 	echo "$line" >"$QT_WORK/txtime-$1.txt"
 }
 as_json() { sed -n 's/^n=\([0-9]*\) late_us p50=\([-0-9.]*\) p99=\([-0-9.]*\) max=\([-0-9.]*\) min=\([-0-9.]*\) spread_us=\([-0-9.]*\)$/{"n":\1,"p50_us":\2,"p99_us":\3,"max_us":\4,"min_us":\5,"spread_us":\6}/p' "$1" 2>/dev/null; }

@@ -42,6 +42,10 @@ class SendPath {
   void Prepare(bool adopted);
   /// Last of start-up: the periodic signals are due from `now` on.
   void StartPeriods(uint64_t now);
+  /// Send on the cycle (send_cycle_daemon.cpp), start-up after the transport is open and
+  /// before the capabilities go (SO_TXTIME on CLOCK_TAI needs CAP_NET_ADMIN then): the
+  /// schedule from <realtime>, the launch mode from the socket and the qdisc.
+  void StartCycle();
   /// The send thread's body; returns once ThreadHandoffs::running is false.
   void RunTx();
 
@@ -94,6 +98,10 @@ class SendPath {
   void SendLargeValues(uint64_t now);
   void SendFragments(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
                      const void* value, uint64_t now);
+  // Send on the cycle (send_cycle_daemon.cpp): the periodic signals on the grid of the
+  // current alignment clock; before a round's frames go out, its launch time or a sleep.
+  void PlaceOnCycle(uint64_t now);
+  void CycleRound(uint64_t instant);
 
   // Shared with the other parts (Daemon owns them).
   store::Segment& segment_;
@@ -122,6 +130,10 @@ class SendPath {
   uint32_t collected_count_ = 0;
   std::vector<LargePending> large_pending_;       // large values due this send round
   bool sending_large_ = false;
+  // Send on the cycle.
+  uint32_t cycle_generation_ = UINT32_MAX;  // the grid due_ns_ is on (none yet)
+  uint64_t flush_launch_tai_ = 0;           // FlushPeer: this round's launch time (CLOCK_TAI), 0 = none
+  uint64_t cycle_margin_ns_ = 0;            // an instant nearer than this is late (ETF delta + slack)
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t tx_older_[kMaxValueBytes];  // CatchUp's copy of an older value
 };

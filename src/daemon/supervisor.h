@@ -48,6 +48,7 @@ class Supervisor {
 
  private:
   void SuperviseClock(uint64_t now);  // this board's clock into the segment and the log
+  void SuperviseSendCycle(uint64_t now, bool synced);  // send_cycle_daemon.cpp
 
   // Shared with the other parts (Daemon owns them).
   store::Segment& segment_;
@@ -69,6 +70,7 @@ class Supervisor {
   uint32_t socket_drops_seen_ = 0;         // the kernel's count for our socket at the last look
   uint64_t by_arrival_logged_ = 0, by_arrival_next_log_ns_ = 0;
   uint64_t other_version_logged_ = 0, other_version_next_log_ns_ = 0;
+  uint64_t etf_drops_logged_ = 0, etf_drops_next_log_ns_ = 0;  // send on the cycle
 };
 
 }  // namespace ccomm

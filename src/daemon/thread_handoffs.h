@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstdint>
 
+#include "daemon/send_cycle.h"
 #include "store/segment.h"
 
 namespace ccomm {
@@ -33,6 +34,14 @@ struct ThreadHandoffs {
   std::atomic<uint64_t> by_arrival_frames{0};
   std::atomic<uint64_t> other_version_frames{0};
   std::atomic<uint32_t> other_version_last{0};
+  // Send on the cycle (send_cycle.h): configured by the send part at start-up; then the
+  // supervision tick sets its alignment clock (SetClock) and the send thread reads it
+  // (Place, LaunchTai); its own fields say which are atomic. CLOCK_TAI - CLOCK_REALTIME in
+  // whole seconds, written once at start-up before the threads run.
+  SendCycle send_cycle;
+  int64_t tai_minus_realtime_ns = 0;
+  /// CLOCK_TAI - CLOCK_MONOTONIC now (send_cycle_daemon.cpp).
+  int64_t TaiMinusMonotonicNs() const;
 
   /// Supervision (and tests): this board's clock for the receive thread.
   void PublishSelfClock(bool synced, int64_t realtime_offset_ns) {

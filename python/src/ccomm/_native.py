@@ -169,6 +169,7 @@ class ProductionAge(ctypes.Structure):
         ("known", ctypes.c_int32),
         ("age_ns", ctypes.c_int64),
         ("error_ns", ctypes.c_int64),
+        ("production_time_ns", ctypes.c_int64),
     ]
 
 
@@ -325,6 +326,7 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_get_peer_clock_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_clock_state_sized": ([vp, vp, sz], c_int),
         "ccomm_clock_state_name": ([c_int], cp),
+        "ccomm_production_age_name": ([c_int], cp),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
         "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),

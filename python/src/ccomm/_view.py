@@ -56,24 +56,53 @@ def system_view(handle: int) -> Dict[str, Any]:
         L.ccomm_view_close(v)
 
 
-# ccomm_production_age_code, by value.
-_AGE_CODES = {0: "synced", 1: "same_node", 2: "never", 3: "local_unsynced", 4: "producer_unsynced",
-              5: "no_summary"}
+class ProductionAges:
+    """ccomm_view_production_age for many reads: the view is opened once (close() or `with`)
+    and the structs are preallocated, so a loop that records or shows every value pays
+    one foreign call per value. `of()` fills `out` (a _native.ProductionAge) and returns it."""
+
+    def __init__(self, handle: int) -> None:
+        self._lib = _native.lib()
+        self._v = ctypes.c_void_p()
+        _check(self._lib.ccomm_view_open(handle, ctypes.byref(self._v)), "system view")
+        self._info = _native.Info()
+        self.out = _native.ProductionAge()
+        self._info_ref, self._out_ref = ctypes.byref(self._info), ctypes.byref(self.out)
+        self._size = ctypes.sizeof(self.out)
+
+    def of(self, signal_id: int, seq: int, source_time_ns: int) -> "_native.ProductionAge":
+        self._info.seq, self._info.source_time_ns = seq, source_time_ns
+        _check(self._lib.ccomm_view_production_age_sized(self._v, signal_id, self._info_ref, self._out_ref,
+                                                         self._size), "production age")
+        return self.out
+
+    @property
+    def raw(self) -> ctypes.c_void_p:
+        """The ccomm_view pointer, for a loop that makes the call itself."""
+        return self._v
+
+    def close(self) -> None:
+        if self._v:
+            self._lib.ccomm_view_close(self._v)
+            self._v = ctypes.c_void_p()
+
+    def __enter__(self) -> "ProductionAges":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+def age_code_name(code: int) -> str:
+    """The name of a ccomm_production_age_code ("synced", "local_unsynced", ...)."""
+    return _native.lib().ccomm_production_age_name(code).decode()
 
 
 def production_age(handle: int, signal_id: int, seq: int, source_time_ns: int) -> Dict[str, Any]:
     """ccomm_view_production_age for the value a read returned (its seq and source time)."""
-    L = _native.lib()
-    v = ctypes.c_void_p()
-    _check(L.ccomm_view_open(handle, ctypes.byref(v)), "system view")
-    try:
-        info = _native.Info()
-        info.seq, info.source_time_ns = seq, source_time_ns
-        pa = _native.ProductionAge()
-        _check(L.ccomm_view_production_age_sized(v, signal_id, ctypes.byref(info), ctypes.byref(pa),
-                                                 ctypes.sizeof(pa)), "production age")
+    with ProductionAges(handle) as ages:
+        pa = ages.of(signal_id, seq, source_time_ns)
         known = bool(pa.known)
-        return {"known": known, "code": _AGE_CODES.get(pa.code, str(pa.code)),
-                "age_ns": pa.age_ns if known else None, "error_ns": pa.error_ns if known else None}
-    finally:
-        L.ccomm_view_close(v)
+        return {"known": known, "code": age_code_name(pa.code),
+                "age_ns": pa.age_ns if known else None, "error_ns": pa.error_ns if known else None,
+                "production_time_ns": pa.production_time_ns if known else None}

@@ -95,7 +95,8 @@ class ProductionAges:
 
 def age_code_name(code: int) -> str:
     """The name of a ccomm_production_age_code ("synced", "local_unsynced", ...)."""
-    return _native.lib().ccomm_production_age_name(code).decode()
+    name: bytes = _native.lib().ccomm_production_age_name(code)
+    return name.decode()
 
 
 def production_age(handle: int, signal_id: int, seq: int, source_time_ns: int) -> Dict[str, Any]:

@@ -30,6 +30,7 @@ def cmd_samples(a):
     rows = [json.loads(line) for line in open(a.file)]
     errors = []
     ks = []
+    skews = []
     for r in rows:
         data = r["data"] if isinstance(r["data"], list) else [r["data"]]
         data = [int(x) if isinstance(x, bool) else x for x in data]
@@ -42,6 +43,7 @@ def cmd_samples(a):
             # source timestamp (wall) = write time (the producer's monotonic clock) moved to
             # the wall clock (plus --stamp-offset-ms: an arrival stamp is that much later)
             skew_ms = (r["src_ts"] - (t - a.mono_minus_wall)) / 1e6
+            skews.append(skew_ms)
             if abs(skew_ms - a.stamp_offset_ms) > a.stamp_tolerance_ms:
                 errors.append("source timestamp %.3f ms off the write time (want %.1f +/- %.1f)"
                               % (skew_ms, a.stamp_offset_ms, a.stamp_tolerance_ms))
@@ -64,7 +66,12 @@ def cmd_samples(a):
         errors.append("%d values, want %d" % (len(rows), a.n))
     for e in errors[:10]:
         print("#   " + e)
-    print("# %d samples checked, %d problems" % (len(rows), len(errors)))
+    stamps = ""
+    if skews:
+        skews.sort()
+        stamps = "; source timestamp - write time: median %.3f ms, range %.3f .. %.3f ms" % (
+            skews[len(skews) // 2], skews[0], skews[-1])
+    print("# %d samples checked, %d problems%s" % (len(rows), len(errors), stamps))
     return 1 if errors else 0
 
 

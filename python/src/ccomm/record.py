@@ -47,7 +47,9 @@ Every value of the states the node receives needs its history tap, signals.xml:
 
 Open the file in Foxglove or PlotJuggler, or read it with the `mcap` Python package:
 one channel per signal (topic = signal name), JSON messages with value, seq,
-source_time_ns, receive_time_ns, status, lost and gap. See docs/integrations/record.md.
+source_time_ns, receive_time_ns, status, lost, gap and the production time on the boards'
+common (PTP) time base when known (production_time_ns, production_error_ns, age_code;
+also the MCAP publish time, else the receive time). See docs/integrations/record.md.
 Exit status: 0 done, 1 runtime error, 2 bad arguments or selection.
 """
 

@@ -388,13 +388,15 @@ def small_recording(path: str) -> None:
     w = RecordingWriter(WriterOptions(output=path, signals=sigs, node="a", chunk_size=2048))
     w._open()
     buf = bytearray()
+    unknown = (-1, -1, 3)  # production time unknown (local_unsynced)
     for k in range(1, 201):
         t = 1_000_000 * k
-        buf += RECORD.pack(0, 0, 0, k, t + 50, t, 0) + struct.pack("<d", k / 3)
-        buf += RECORD.pack(1, 1, 0, k, t + 50, t, 0) + struct.pack("<4d", k, float("nan"), float("inf"), -k)
-        buf += RECORD.pack(2, 0, 0, k, t + 50, t, 0) + struct.pack("<i", -k)
+        produced = (1_700_000_000_000_000_000 + t, 0, 1)  # same_node: known, exact
+        buf += RECORD.pack(0, 0, 0, k, t + 50, t, 0, *produced) + struct.pack("<d", k / 3)
+        buf += RECORD.pack(1, 1, 0, k, t + 50, t, 0, *unknown) + struct.pack("<4d", k, float("nan"), float("inf"), -k)
+        buf += RECORD.pack(2, 0, 0, k, t + 50, t, 0, *produced) + struct.pack("<i", -k)
         if k % 10 == 0:
-            buf += RECORD.pack(3, 0, 0, k // 10, t + 50, t, 0) + struct.pack("<?", k % 20 == 0)
+            buf += RECORD.pack(3, 0, 0, k // 10, t + 50, t, 0, *unknown) + struct.pack("<?", k % 20 == 0)
     assert w.add(buf) == len(buf)
     w._close()
 

@@ -202,6 +202,13 @@ stop_daemon planner
 start_rt_daemon planner
 sleep 0.3
 check "after a ccommd restart on B (same configuration) values flow both ways" flows
+production_again() {  # the restarted ccommd has a new system view: the bridge follows it
+  wait_for 60 both_synced || { note "clocks not synced again"; return 1; }
+  local p0; p0=$(bridge_stat pos stamped_production)
+  produced_ago pos 20 300 && grew_by "$p0" "$(bridge_stat pos stamped_production)" 20
+}
+check "  ... and once B's clock is synced again, source timestamps are production times again (the bridge opened the new ccommd's view)" \
+  production_again
 # The new configuration also changes pos's stale_after_ms (50 -> 120 ms): the bridge must
 # offer the new deadline after it reattaches.
 sed -e 's|</ccomm>|  <signal name="extra" type="double" producer="control" consumers="planner"/>\n</ccomm>|' \

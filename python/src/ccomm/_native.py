@@ -320,6 +320,7 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_set_time": ([vp, i64], c_int),
         "ccomm_now": ([], i64),
         "ccomm_daemon_alive": ([vp], c_int),
+        "ccomm_daemon_generation": ([vp], u32),
         "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),
         "ccomm_node_count": ([vp], c_int),
         "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),

@@ -4,7 +4,7 @@ summaries (ccomm.h, ccomm_view_*; what `ccomm stats --all --json` prints)."""
 from __future__ import annotations
 
 import ctypes
-from typing import Any, Dict, List
+from typing import Any, Dict, List, Optional
 
 from . import _native
 from ._errors import _check
@@ -63,7 +63,10 @@ class ProductionAges:
 
     def __init__(self, handle: int) -> None:
         self._lib = _native.lib()
+        self._handle = handle
         self._v = ctypes.c_void_p()
+        self._generation = self._lib.ccomm_daemon_generation(handle)
+        self._recheck_at = 0.0
         _check(self._lib.ccomm_view_open(handle, ctypes.byref(self._v)), "system view")
         self._info = _native.Info()
         self.out = _native.ProductionAge()
@@ -71,15 +74,38 @@ class ProductionAges:
         self._size = ctypes.sizeof(self.out)
 
     def of(self, signal_id: int, seq: int, source_time_ns: int) -> "_native.ProductionAge":
+        """The production age of a read (its seq and source time); code no_summary while
+        there is no view (see follow())."""
         self._info.seq, self._info.source_time_ns = seq, source_time_ns
+        if not self._v:
+            self.out.code, self.out.known = 5, 0
+            self.out.age_ns = self.out.error_ns = self.out.production_time_ns = -1
+            return self.out
         _check(self._lib.ccomm_view_production_age_sized(self._v, signal_id, self._info_ref, self._out_ref,
                                                          self._size), "production age")
         return self.out
 
+    def follow(self, now: float) -> None:
+        """Call about once a second (`now`: time.monotonic()). A ccommd restarted on the same
+        configuration keeps the segment but makes a new view (the old one stops: its clocks
+        would time out and every production time be unknown). It adopts the segment
+        (generation + 1) just before it creates the view: the view is opened again when
+        the generation changes and once more 2 s later, in case the first came between.
+        Without a view (not there yet) `raw` is None and ages are unknown."""
+        generation = self._lib.ccomm_daemon_generation(self._handle)
+        restarted = generation != self._generation
+        if not restarted and (not self._recheck_at or now < self._recheck_at):
+            return
+        self._generation, self._recheck_at = generation, (now + 2.0 if restarted else 0.0)
+        self.close()
+        v = ctypes.c_void_p()
+        if self._lib.ccomm_view_open(self._handle, ctypes.byref(v)) == 0:
+            self._v = v
+
     @property
-    def raw(self) -> ctypes.c_void_p:
-        """The ccomm_view pointer, for a loop that makes the call itself."""
-        return self._v
+    def raw(self) -> Optional[ctypes.c_void_p]:
+        """The ccomm_view pointer, for a loop that makes the call itself (None: no view)."""
+        return self._v if self._v else None
 
     def close(self) -> None:
         if self._v:

@@ -195,12 +195,12 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
     page = _native.ProductionAge()
     page_addr, page_size = ctypes.addressof(page), ctypes.sizeof(page)
     unpack_page = struct.Struct(_native.unpack_format(_native.ProductionAge)).unpack_from
-    view_ptr = ages.raw if ages is not None else None
     hist_info = _native.Info()  # a history read's seq and source time, for the age call
     hist_info_addr = ctypes.addressof(hist_info)
 
     def production(sid: int, info_at: int) -> Any:
         # (production time or -1, its error or -1, age code); an error gives "no_summary"
+        view_ptr = ages.raw if ages is not None else None
         if view_ptr is None or production_age(view_ptr, sid, info_at, page_addr, page_size) != 0:
             return -1, -1, 5
         code, known, _age, err, ptime = unpack_page(page)
@@ -291,6 +291,8 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
             last_send = t
         if t - last_check >= 1_000_000_000:
             last_check = t
+            if ages is not None:
+                ages.follow(time.monotonic())  # a restarted ccommd's new view
             if not writer_alive():
                 return 1
             if len(pending) > 256 << 20 and not warned:

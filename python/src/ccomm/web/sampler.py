@@ -131,6 +131,7 @@ class Sampler:
     _now_ns: int = 0
 
     _ages: Optional[_view.ProductionAges] = None
+    _followed: float = 0.0
 
     def __post_init__(self) -> None:
         self._tracked = [_Tracked(self.client.signal(n)) for n in self.names]
@@ -159,6 +160,9 @@ class Sampler:
     def poll(self, now: Optional[float] = None) -> int:
         """One pass over every signal; returns how many messages were published."""
         now = time.monotonic() if now is None else now
+        if self._ages is not None and now - self._followed >= 1.0:
+            self._followed = now
+            self._ages.follow(now)  # a restarted ccommd's new view
         self._now_ns = self.client.now()  # receive times: one clock reading per pass
         sent = 0
         for t in self._tracked:

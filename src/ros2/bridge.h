@@ -101,6 +101,8 @@ struct Bridge {
   std::atomic<bool> stop{false};
   std::atomic<int> fatal{0};  // non-zero: exit status a worker asks for
   ccomm_view* to_ros_view = nullptr;  // the ccomm -> ROS 2 thread's system view (production ages)
+  uint32_t view_generation = 0;       // ccommd generation it was opened under
+  int64_t view_recheck_ns = 0;        // when to open it once more after a ccommd restart (0: no)
 
   Bridge() = default;
   Bridge(const Bridge&) = delete;

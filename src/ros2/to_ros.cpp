@@ -177,16 +177,30 @@ void StartRoutes(ccomm_client* c, const std::vector<Route*>& routes) {
 
 // The system view gives production ages (the node summaries' clocks). Without one (a
 // ccommd older than the view) every sample is stamped with its arrival, said once.
-void OpenView(Bridge* b, ccomm_client* c) {
+void OpenView(Bridge* b, ccomm_client* c, bool quiet = false) {
+  b->view_generation = ccomm_daemon_generation(c);
   const int rc = ccomm_view_open(c, &b->to_ros_view);
   if (rc != 0) {
     b->to_ros_view = nullptr;
-    fprintf(stderr, "ccomm-ros2: no system view (%s): source timestamps are arrival times\n", ccomm_strerror(rc));
+    if (!quiet)
+      fprintf(stderr, "ccomm-ros2: no system view (%s): source timestamps are arrival times\n", ccomm_strerror(rc));
   }
 }
 void CloseView(Bridge* b) {
   if (b->to_ros_view) ccomm_view_close(b->to_ros_view);
   b->to_ros_view = nullptr;
+}
+// A ccommd restarted on the same configuration keeps the segment but makes a new view
+// (the old one stops: its clocks would time out, every stamp local). It adopts the
+// segment (generation + 1) just before it creates the view, so the view is opened again
+// when the generation changes and once more 2 s later, in case the first came between.
+void FollowView(Bridge* b, ccomm_client* c) {
+  const int64_t now = ccomm_now();
+  const bool restarted = ccomm_daemon_generation(c) != b->view_generation;
+  if (!restarted && (b->view_recheck_ns == 0 || now < b->view_recheck_ns)) return;
+  b->view_recheck_ns = restarted ? now + 2000000000 : 0;
+  CloseView(b);
+  OpenView(b, c, /*quiet=*/restarted);
 }
 
 }  // namespace
@@ -214,6 +228,7 @@ void RunToRos(Bridge* b) {
   OpenView(b, c);
   while (!b->stop.load(std::memory_order_relaxed)) {
     ccomm_wait(c, 100);  // returns at once on a change; 100 ms to notice stop/retirement
+    FollowView(b, c);
     int err = 0;
     for (Route* r : b->to_ros) {
       err = Pump(b, c, r);

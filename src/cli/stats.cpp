@@ -113,6 +113,15 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("clock: %s (ptp4l port state %d, offset %" PRId64 " ns)%s\n", ccomm_clock_state_name(now.clock.state),
            now.clock.port_state, now.clock.offset_ns,
            "; ages are local");
+  for (size_t i = 0; i < now.counters.size(); ++i) {  // send on the cycle (daemon/send_cycle.h, LaunchMode)
+    static const char* const kLaunch[] = {"off", "launch times (SO_TXTIME, ETF qdisc)",
+                                          "sleeps until each instant (launch_time=\"sleep\")",
+                                          "sleeps until each instant (no SO_TXTIME on this platform)",
+                                          "sleeps until each instant (the socket refused SO_TXTIME)",
+                                          "sleeps until each instant (no ETF qdisc for its frames)"};
+    if (strcmp(now.counter_names[i], "cycle_launch") == 0 && now.counters[i] && now.counters[i] < 6)
+      printf("send cycle: %s\n", kLaunch[now.counters[i]]);
+  }
   printf("daemon:");
   for (size_t i = 0; i < now.counters.size(); ++i) {
     if (now.counters[i] || i < 3) printf(" %s=%" PRIu64, now.counter_names[i], now.counters[i]);

@@ -236,7 +236,8 @@ int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name
       "frames_unknown_sender", "frames_auth_failed", "frames_replayed", "frames_not_for_us",
       "entries_unknown_signal", "entries_wrong_type", "send_errors",  "tx_wakeups",
       "recv_errors",       "slots_reclaimed",    "socket_drops",    "frames_wrong_source",
-      "frames_foreign"};
+      "frames_foreign",    "cycle_rounds",       "cycle_late",      "cycle_etf_drops",
+      "cycle_launch"};
   static_assert(sizeof(kNames) / sizeof(kNames[0]) == st::kDaemonCounterCount, "one name per DaemonCounter");
   if (!c || index < 0 || static_cast<uint32_t>(index) >= st::kDaemonCounterCount) return CCOMM_E_INVAL;
   if (name) *name = kNames[index];

@@ -45,6 +45,13 @@ struct RealtimeConfig {
   int priority = 0;   // SCHED_FIFO priority for ccommd's I/O threads; 0 = SCHED_OTHER
   int cpu = -1;       // CPU affinity for ccommd's I/O threads; -1 = any
   uint32_t spin_us = 0;  // busy-poll window after activity before sleeping (0 = pure event-driven)
+  // Send on the cycle (daemon/send_cycle.h): periodic frames leave at k * period +
+  // send_phase_us of a clock the boards share. 0 = off. Local policy (not in the hash).
+  uint32_t send_cycle_us = 0;    // divides one second
+  uint32_t send_phase_us = 0;    // < send_cycle_us
+  uint32_t send_lead_us = 0;     // wake this early (< send_cycle_us); 0 in the file = default
+  bool launch_time = true;       // launch_time="auto": SO_TXTIME where the kernel can; "sleep": never
+  int send_cycle_line = 0;       // line of the send_cycle_us attribute, for messages
 };
 
 struct NodeConfig {

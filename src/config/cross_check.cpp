@@ -119,6 +119,15 @@ void Parser::CrossCheck(SystemConfig* cfg) {
       s.consumers.push_back(m);
       check_transport(s, producer, m, mn.line);
     }
+    // Send on the cycle: a periodic signal leaves on instants of its producer's cycle.
+    if (producer >= 0 && s.period_us) {
+      const RealtimeConfig& rt = cfg->nodes[static_cast<size_t>(producer)].realtime;
+      if (rt.send_cycle_us && s.period_us % rt.send_cycle_us != 0)
+        Err(s.line, "period of signal " + Quote(s.name) + " (" + std::to_string(s.period_us) +
+                        " us) is not a multiple of its producer " + Quote(cfg->nodes[static_cast<size_t>(producer)].name) +
+                        "'s send_cycle_us " + std::to_string(rt.send_cycle_us) + " (line " +
+                        std::to_string(rt.send_cycle_line) + ")");
+    }
   }
   CrossCheckClock(cfg);
 }

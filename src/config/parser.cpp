@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "config/parser.h"
 
+#include <algorithm>
 #include <cstring>
 
 namespace ccomm {
@@ -380,7 +381,8 @@ void Parser::NodeElement(const Node* n, bool only_node, NodeConfig* node) {
 }
 
 void Parser::Realtime(const Node* n, RealtimeConfig* rt) {
-  Element e(n, {"mlockall", "priority", "cpu", "spin_us"}, &diag_);
+  Element e(n, {"mlockall", "priority", "cpu", "spin_us", "send_cycle_us", "send_phase_us", "send_lead_us", "launch_time"},
+            &diag_);
   CheckNoText(n, &diag_);
   for (const Node* c = n->first_node(); c; c = c->next_sibling())
     if (c->type() == rapidxml::node_element)
@@ -390,6 +392,52 @@ void Parser::Realtime(const Node* n, RealtimeConfig* rt) {
   Signed(e, "priority", 1, 99, &rt->priority);
   Signed(e, "cpu", 0, kMaxCpu, &rt->cpu);
   Unsigned(e, "spin_us", 0, kMaxSpinUs, &rt->spin_us);
+  SendCycle(e, rt);
+}
+
+// Send on the cycle (docs/config.md, <realtime>): the cycle divides one second (so boards
+// whose TAI clocks differ by whole seconds share the grid), phase and lead below it.
+void Parser::SendCycle(const Element& e, RealtimeConfig* rt) {
+  const AttrValue* cycle = e.Get("send_cycle_us");
+  if (!cycle) {
+    for (const char* attr : {"send_phase_us", "send_lead_us", "launch_time"})
+      if (const AttrValue* a = e.Get(attr)) Err(a->line, std::string(attr) + " without send_cycle_us");
+    return;
+  }
+  rt->send_cycle_line = cycle->line;
+  uint32_t c = 0;
+  if (!Unsigned(e, "send_cycle_us", kMinSendCycleUs, kMaxSendCycleUs, &c)) return;
+  if (kMaxSendCycleUs % c != 0) {
+    Err(cycle->line, "send_cycle_us " + cycle->value + " does not divide one second (e.g. 250, 500, 1000, 2000)");
+    return;
+  }
+  rt->send_cycle_us = c;
+  if (Unsigned(e, "send_phase_us", 0, kMaxSendCycleUs, &rt->send_phase_us) && rt->send_phase_us >= c) {
+    Err(e.Get("send_phase_us")->line, "send_phase_us " + std::to_string(rt->send_phase_us) +
+                                          " is not below send_cycle_us " + std::to_string(c));
+    rt->send_phase_us = 0;
+  }
+  rt->send_lead_us = std::min(kDefaultSendLeadUs, c / 2);
+  if (const AttrValue* a = e.Get("send_lead_us")) {
+    uint32_t lead = 0;
+    if (Unsigned(e, "send_lead_us", 0, kMaxSendCycleUs, &lead)) {
+      if (lead < kMinSendLeadUs)
+        Err(a->line, "send_lead_us " + a->value + " is too small (at least " + std::to_string(kMinSendLeadUs) +
+                         " us: the send thread builds the frames in it)");
+      else if (lead >= c)
+        Err(a->line, "send_lead_us " + a->value + " is not below send_cycle_us " + std::to_string(c));
+      else
+        rt->send_lead_us = lead;
+    }
+  }
+  if (const AttrValue* a = e.Get("launch_time")) {
+    if (a->value == "auto")
+      rt->launch_time = true;
+    else if (a->value == "sleep")
+      rt->launch_time = false;
+    else
+      Err(a->line, "unknown launch_time " + Quote(a->value) + " (expected auto or sleep)");
+  }
 }
 
 }  // namespace config_detail

@@ -26,6 +26,10 @@ constexpr uint32_t kMaxHeartbeatMs = 10000;
 constexpr uint32_t kMaxPeerTimeoutMs = 60000;
 constexpr uint32_t kMinSummaryMs = 100, kMaxSummaryMs = 60000;
 constexpr uint32_t kMaxSpinUs = 100000;
+// Send on the cycle: the cycle divides one second (50 us .. 1 s); the lead covers building
+// the frames and the ETF qdisc's delta.
+constexpr uint32_t kMinSendCycleUs = 50, kMaxSendCycleUs = 1000000;
+constexpr uint32_t kMinSendLeadUs = 20, kDefaultSendLeadUs = 300;
 constexpr int kMaxCpu = 1023;  // CPU_SETSIZE - 1
 constexpr uint32_t kMinQueueDepth = 2;
 constexpr uint32_t kMaxQueueDepth = 65536;
@@ -139,6 +143,7 @@ class Parser {
   void Network(const Node* n, NetworkConfig* net);
   void NodeElement(const Node* n, bool only_node, NodeConfig* node);
   void Realtime(const Node* n, RealtimeConfig* rt);
+  void SendCycle(const Element& e, RealtimeConfig* rt);
   void SignalElement(const Node* n, SignalConfig* sig, SignalRefs* refs);
   void SafeValue(const AttrValue& a, SignalConfig* sig);
   void CrossCheck(SystemConfig* cfg);

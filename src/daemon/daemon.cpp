@@ -171,6 +171,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   }
   r = view_.Start(cfg, node_id, kind, opt.force_udp, &segment_, &transport_, &auth_, gid, error);
   if (r != 0) return r;
+  StartSendCycle();  // send on the cycle (send_cycle_daemon.cpp)
 
   uint64_t now = platform::MonotonicNs();
   for (uint32_t id : periodic_) due_ns_[id] = now;

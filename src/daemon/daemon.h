@@ -15,6 +15,7 @@
 #include "daemon/foreign_frames.h"
 #include "daemon/peer_clock.h"
 #include "daemon/ptp_state.h"
+#include "daemon/send_cycle.h"
 #include "daemon/system_view_writer.h"
 #include "daemon/transport.h"
 #include "store/reclaim.h"
@@ -261,6 +262,19 @@ class Daemon {
   std::vector<LargePending> large_pending_;       // large values due this send round
   bool sending_large_ = false;
   bool large_refusal_logged_ = false;
+  // --- send on the cycle (send_cycle.h; send_cycle_daemon.cpp) ---
+  void StartSendCycle();                               // Start(), before the capabilities go
+  void SuperviseSendCycle(uint64_t now, bool synced);  // supervision tick
+  void PlaceOnCycle(uint64_t now);                     // send thread: due_ns_ on the grid
+  void CycleRound(uint64_t instant);                   // send thread: launch time, or sleep until it
+  int64_t TaiMinusMonotonicNs() const;
+  SendCycle send_cycle_;
+  uint32_t cycle_generation_ = UINT32_MAX;  // send thread: the grid due_ns_ is on (none yet)
+  uint64_t flush_launch_tai_ = 0;   // FlushPeer: this launch time (CLOCK_TAI), 0 = none
+  uint64_t cycle_margin_ns_ = 0;    // an instant nearer than this is late (ETF delta + slack)
+  int64_t tai_minus_realtime_ns_ = 0;
+  uint64_t etf_drops_logged_ = 0, etf_drops_next_log_ns_ = 0;
+  // --- end send on the cycle ---
   alignas(8) uint8_t tx_value_[kMaxValueBytes];
   alignas(8) uint8_t tx_older_[kMaxValueBytes];  // CatchUp's copy of an older value
   alignas(8) uint8_t rx_value_[kMaxValueBytes];

@@ -15,6 +15,7 @@ void Daemon::SuperviseClock(uint64_t now) {
   self.clock_path_delay_ns.store(static_cast<uint64_t>(ptp_.path_delay_ns()), std::memory_order_relaxed);
   self.clock_state.store(word, std::memory_order_release);
   PublishSelfClock(ptp_.state() == ptp::ClockState::kSynced, platform::RealtimeOffsetNs());
+  SuperviseSendCycle(now, ptp_.state() == ptp::ClockState::kSynced);  // send on the cycle
   const uint64_t by_arrival = by_arrival_frames_.load(std::memory_order_relaxed);
   if (by_arrival != by_arrival_logged_ && now >= by_arrival_next_log_ns_) {
     Log(LogLevel::kNotice, "%llu frame(s) with stale_by=\"production\" values judged by their arrival: this "

@@ -3,9 +3,11 @@
 # build (src/windows.cmake): the portable files, and per platform the whole files that
 # are its platform code (sockets, interfaces, privileges, key file, ptp4l, stop requests, service).
 set(CCOMM_DAEMON_SOURCES daemon.cpp tx_path.cpp rx_path.cpp prepared_signals.cpp system_view_writer.cpp large_values.cpp
-    transport_address.cpp auth.cpp ptp_state.cpp ptp_clock.cpp ptp_config.cpp node_identity.cpp)
+    transport_address.cpp auth.cpp ptp_state.cpp ptp_clock.cpp ptp_config.cpp node_identity.cpp
+    send_cycle.cpp send_cycle_daemon.cpp)
 set(CCOMM_DAEMON_POSIX_SOURCES transport_raw.cpp foreign_frames.cpp transport_udp.cpp node_interfaces_posix.cpp
-    privileges.cpp auth_key_file_posix.cpp ptp_socket_posix.cpp stop_request_posix.cpp service_none.cpp)
+    privileges.cpp auth_key_file_posix.cpp ptp_socket_posix.cpp stop_request_posix.cpp service_none.cpp
+    txtime_socket_posix.cpp)
 set(CCOMM_DAEMON_WINDOWS_SOURCES raw_ethernet_none.cpp transport_udp_windows.cpp node_interfaces_windows.cpp
     privileges_windows.cpp auth_key_file_windows.cpp ptp_socket_windows.cpp stop_request_windows.cpp
     service_windows.cpp)

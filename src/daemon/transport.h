@@ -15,6 +15,7 @@
 #include <string>
 
 #include "config/config.h"
+#include "daemon/send_cycle.h"
 
 namespace ccomm {
 
@@ -44,13 +45,26 @@ struct TransportOps {
   int (*join_groups)(Transport* t, const PeerAddress* groups, size_t n, std::string* error);
   /// Closes the socket and frees the state.
   void (*close)(Transport* t);
+  // send on the cycle (send_cycle.h): nullptr where the transport has no launch times.
+  /// Start-up: SO_TXTIME on the socket and the interface's qdiscs, into `probe`.
+  void (*txtime_setup)(Transport* t, TxtimeProbe* probe, std::string* detail);
+  /// Sends one frame with launch time `launch_tai_ns` (CLOCK_TAI); 0 or -errno.
+  int (*send_at)(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len, uint64_t launch_tai_ns);
+  /// Frames the ETF qdisc reported dropped since the last call (supervision tick).
+  uint32_t (*txtime_drops)(Transport* t);
 };
 
 struct Transport {
   const TransportOps* ops = nullptr;
   void* state = nullptr;  // the transport's own, allocated at open (start-up)
+  // send on the cycle: with launch times on, every frame needs one (ETF drops frames
+  // without): Send() gives it "now + txtime_asap_ns". 0: launch times off.
+  uint64_t txtime_asap_ns = 0;
 
   int Send(const PeerAddress& to, const uint8_t* f, size_t n) { return ops->send(this, to, f, n); }
+  int SendAt(const PeerAddress& to, const uint8_t* f, size_t n, uint64_t launch_tai_ns) {  // send on the cycle
+    return ops->send_at(this, to, f, n, launch_tai_ns);
+  }
   ssize_t Recv(uint8_t* b, size_t cap, PeerAddress* from) { return ops->recv(this, b, cap, from); }
   int SocketDrops(uint32_t* drops) { return ops ? ops->socket_drops(this, drops) : -EBADF; }
   int JoinGroups(const PeerAddress* g, size_t n, std::string* error) { return ops->join_groups(this, g, n, error); }

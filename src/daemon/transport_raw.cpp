@@ -15,6 +15,7 @@
 
 #include "common/platform.h"
 #include "daemon/transport.h"
+#include "daemon/txtime_socket.h"
 #include "wire/wire.h"
 
 namespace ccomm {
@@ -39,6 +40,8 @@ int RawSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t le
   sll.sll_protocol = htons(State(t)->ethertype);
   sll.sll_halen = 6;
   memcpy(sll.sll_addr, to.mac, 6);
+  if (t->txtime_asap_ns)  // send on the cycle: launch times on (send_cycle.h)
+    return SendWithLaunch(State(t)->fd, &sll, sizeof sll, frame, len, TaiNs() + t->txtime_asap_ns);
   ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll);
   return n == static_cast<ssize_t>(len) ? 0 : -errno;
 }
@@ -115,7 +118,33 @@ void RawClose(Transport* t) {
   delete st;
 }
 
-const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawDrops, RawJoinGroups, RawClose};
+// --- send on the cycle (send_cycle.h, txtime_socket.h) ---
+int RawSendAt(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len, uint64_t launch_tai_ns) {
+  struct sockaddr_ll sll;
+  memset(&sll, 0, sizeof sll);
+  sll.sll_family = AF_PACKET;
+  sll.sll_ifindex = State(t)->ifindex;
+  sll.sll_protocol = htons(State(t)->ethertype);
+  sll.sll_halen = 6;
+  memcpy(sll.sll_addr, to.mac, 6);
+  return SendWithLaunch(State(t)->fd, &sll, sizeof sll, frame, len, launch_tai_ns);
+}
+void RawTxtimeSetup(Transport* t, TxtimeProbe* probe, std::string* detail) {
+  probe->platform = true;
+  probe->tai_minus_realtime_ns = TaiMinusRealtimeNs();
+  if (!probe->want) return;
+  char name[IF_NAMESIZE] = "?";
+  if_indextoname(static_cast<unsigned>(State(t)->ifindex), name);
+  ProbeEtf(State(t)->ifindex, probe, detail);
+  *detail = std::string(name) + ": " + *detail;
+  // Only for a usable ETF: a socket of priority kTxtimePriority without launch times would
+  // have its frames dropped there.
+  if (probe->etf && probe->etf_delta_ns < probe->lead_ns) probe->socket_error = EnableTxtime(State(t)->fd);
+}
+uint32_t RawTxtimeDrops(Transport* t) { return DrainTxtimeErrors(State(t)->fd); }
+
+const TransportOps kRawOps = {"raw", RawSend, RawRecv, RawDrops, RawJoinGroups, RawClose,
+                              RawTxtimeSetup, RawSendAt, RawTxtimeDrops};
 
 }  // namespace
 

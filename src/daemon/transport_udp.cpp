@@ -7,11 +7,15 @@
 #include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <ifaddrs.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
+
 #include "common/platform.h"
 #include "daemon/transport.h"
+#include "daemon/txtime_socket.h"
 
 namespace ccomm {
 namespace {
@@ -32,6 +36,7 @@ struct UdpState {
   int extra_fd[kMaxSockets] = {};
   struct pollfd polled[kMaxSockets + 1];  // fd, then extra_fd: filled at join
   size_t next = 0;                        // round robin over the ready sockets
+  std::atomic<uint32_t> txtime_drops{0};  // send on the cycle: ETF drops drained by UdpRecv's poll
 };
 
 UdpState* State(Transport* t) { return static_cast<UdpState*>(t->state); }
@@ -42,6 +47,8 @@ int UdpSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t le
   sin.sin_family = AF_INET;
   sin.sin_addr.s_addr = to.ipv4;
   sin.sin_port = to.port ? to.port : State(t)->port;
+  if (t->txtime_asap_ns)  // send on the cycle: launch times on (send_cycle.h)
+    return SendWithLaunch(State(t)->fd, &sin, sizeof sin, frame, len, TaiNs() + t->txtime_asap_ns);
   ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
   return n == static_cast<ssize_t>(len) ? 0 : -errno;
 }
@@ -62,6 +69,7 @@ ssize_t UdpRecv(Transport* t, uint8_t* buf, size_t cap, PeerAddress* from) {
       }
     }
     flags |= MSG_DONTWAIT;
+    if (st->polled[0].revents & POLLERR) st->txtime_drops += DrainTxtimeErrors(st->fd);  // send on the cycle
   }
   struct sockaddr_in sin;
   socklen_t sl = sizeof sin;
@@ -167,7 +175,49 @@ void UdpClose(Transport* t) {
   delete st;
 }
 
-const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, UdpClose};
+// --- send on the cycle (send_cycle.h, txtime_socket.h) ---
+int UdpSendAt(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len, uint64_t launch_tai_ns) {
+  struct sockaddr_in sin;
+  memset(&sin, 0, sizeof sin);
+  sin.sin_family = AF_INET;
+  sin.sin_addr.s_addr = to.ipv4;
+  sin.sin_port = to.port ? to.port : State(t)->port;
+  return SendWithLaunch(State(t)->fd, &sin, sizeof sin, frame, len, launch_tai_ns);
+}
+// The qdiscs that count are those of interface= or, without it, of the interface with ip=.
+void UdpTxtimeSetup(Transport* t, TxtimeProbe* probe, std::string* detail) {
+  UdpState* st = State(t);
+  probe->platform = true;
+  probe->tai_minus_realtime_ns = TaiMinusRealtimeNs();
+  if (!probe->want) return;
+  int ifindex = st->ifindex;
+  struct ifaddrs* list = nullptr;
+  if (!ifindex && st->self_ipv4 && getifaddrs(&list) == 0) {
+    for (struct ifaddrs* a = list; a; a = a->ifa_next)
+      if (a->ifa_addr && a->ifa_addr->sa_family == AF_INET &&
+          reinterpret_cast<struct sockaddr_in*>(a->ifa_addr)->sin_addr.s_addr == st->self_ipv4)
+        ifindex = static_cast<int>(if_nametoindex(a->ifa_name));
+    freeifaddrs(list);
+  }
+  if (!ifindex) {
+    *detail = "no interface known (give the node interface=)";
+    return;
+  }
+  char name[IF_NAMESIZE] = "?";
+  if_indextoname(static_cast<unsigned>(ifindex), name);
+  ProbeEtf(ifindex, probe, detail);
+  *detail = std::string(name) + ": " + *detail;
+  // Only for a usable ETF: a socket of priority kTxtimePriority without launch times would
+  // have its frames dropped there.
+  if (probe->etf && probe->etf_delta_ns < probe->lead_ns) probe->socket_error = EnableTxtime(st->fd);
+}
+uint32_t UdpTxtimeDrops(Transport* t) {
+  UdpState* st = State(t);
+  return DrainTxtimeErrors(st->fd) + st->txtime_drops.exchange(0, std::memory_order_relaxed);
+}
+
+const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, UdpClose,
+                              UdpTxtimeSetup, UdpSendAt, UdpTxtimeDrops};
 
 }  // namespace
 

@@ -120,7 +120,8 @@ void UdpClose(Transport* t) {
   WSACleanup();
 }
 
-const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, UdpClose};
+// No launch times on Windows (no SO_TXTIME): a send cycle sleeps until its instants (send_cycle.h).
+const TransportOps kUdpOps = {"udp", UdpSend, UdpRecv, UdpDrops, UdpJoinGroups, UdpClose, nullptr, nullptr, nullptr};
 
 int Fail(UdpState* st, int e, std::string* error, const std::string& what) {
   *error = what + ": " + WsaText(e);

@@ -33,7 +33,8 @@ void Daemon::FlushPeer(uint32_t peer) {
     len += wire::kAuthTagSize;
   }
   p.seq++;
-  int r = transport_.Send(p.addr, p.buf, len);
+  int r = flush_launch_tai_ ? transport_.SendAt(p.addr, p.buf, len, flush_launch_tai_)  // send on the cycle
+                            : transport_.Send(p.addr, p.buf, len);
   p.last_tx_ns = platform::MonotonicNs();  // also on failure: a dead link must not busy-loop
   if (r != 0) {
     Count(store::kSendErrors);
@@ -253,16 +254,25 @@ void Daemon::RunTx() {
     // Idle, the loop wakes once per heartbeat (or more often if the service watchdog
     // needs it to advance sooner, see idle_sleep_ns_).
     uint64_t next_deadline = now + idle_sleep_ns_;
+    // send on the cycle: periodic signals are due at instants of the grid and taken one
+    // lead early; the round's frames then carry the earliest instant taken.
+    const bool on_cycle = send_cycle_.enabled();
+    if (on_cycle && send_cycle_.generation() != cycle_generation_) PlaceOnCycle(now);
+    const uint64_t lead = on_cycle ? send_cycle_.config().lead_ns : 0, reach = now + lead;
+    uint64_t cycle_instant = UINT64_MAX;
     for (uint32_t id : periodic_) {
-      if (now >= due_ns_[id]) {
+      if (reach >= due_ns_[id]) {
         CollectSignal(id, now, true);
+        if (due_ns_[id] < cycle_instant) cycle_instant = due_ns_[id];
         uint64_t period = uint64_t{cfg_->signals[id].period_us} * 1000;
         due_ns_[id] += period;
-        if (due_ns_[id] <= now) due_ns_[id] = now + period;  // fell behind: do not burst
+        if (due_ns_[id] <= reach)  // fell behind: do not burst
+          due_ns_[id] = on_cycle ? send_cycle_.Place(now, period) : now + period;
       }
-      if (due_ns_[id] < next_deadline) next_deadline = due_ns_[id];
+      if (due_ns_[id] - lead < next_deadline) next_deadline = due_ns_[id] - lead;
     }
     if (!large_pending_.empty()) SendLargeValues(now);
+    if (on_cycle && cycle_instant != UINT64_MAX) CycleRound(cycle_instant);  // send on the cycle
     for (uint32_t p : senders_) {
       PeerTx& pt = peers_tx_[p];
       if (pt.open) {
@@ -274,6 +284,7 @@ void Daemon::RunTx() {
       uint64_t hb_due = pt.last_tx_ns + heartbeat_ns_;
       if (hb_due < next_deadline) next_deadline = hb_due;
     }
+    flush_launch_tai_ = 0;  // send on the cycle: the round's launch time ends with it
 
     // Optional busy-poll window (no syscalls) before sleeping: trades CPU for latency.
     if (spin_ns) {

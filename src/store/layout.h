@@ -79,6 +79,9 @@ enum DaemonCounter : uint32_t {
   kSocketDrops,  // frames the kernel dropped at ccommd's socket (receive buffer full)
   kFramesWrongSource,  // UDP frames whose source address is not the sender's configured one
   kFramesForeign,  // ccomm frames of another transport, EtherType or UDP port (foreign_frames.h)
+  // Send on the cycle (daemon/send_cycle.h): rounds sent on an instant, rounds that woke
+  // after theirs, frames the ETF qdisc dropped, and the launch mode (a LaunchMode, not a count).
+  kCycleRounds, kCycleLate, kCycleEtfDrops, kCycleLaunch,
   kDaemonCounterCount
 };
 static_assert(kDaemonCounterCount <= 32, "daemon_counters has 32 entries");

@@ -34,7 +34,7 @@ const char kUsage[] =
     "                           --interval prints value and status every MS, changed or not\n"
     "  pub SIGNAL VALUE... [--rate HZ] [--count N]\n"
     "                           write a value (arrays: one value per element, or one for all);\n"
-    "                           with --rate, repeat N times (default 1) at HZ\n"
+    "                           with --rate, repeat N times (default 1) at HZ (never faster)\n"
     "  stats [--all] [--json] [--watch SEC]\n"
     "                           daemon, peer and signal counters: rates, loss, staleness;\n"
     "                           --all: every node of the system (alive, the peers it hears,\n"
@@ -234,6 +234,10 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
     if (period_ns && i + 1 < count) {
       next += period_ns;
       ccomm::app::SleepUntilNs(next);
+      // Woken a period late or more (a stalled machine): go on from now, never in a burst
+      // that would exceed HZ (readers and rate figures see what --rate promised).
+      const int64_t now = ccomm_now();
+      if (now - next >= period_ns) next = now;
     }
   }
   return 0;

@@ -74,8 +74,10 @@ def test_link_down_goes_stale_and_recovers():
         pair.link("planner", up=False)
         stale = wait_for(lambda: pair.echo_once("planner", "arm0_pos")[1] == "stale", 2, 0.002)
         assert stale is not None
-        # Measured from the command, so this includes process start-up of the CLI.
-        assert stale < STALE_MS / 1000 + (1.0 if SANITIZED else 0.25), stale
+        # Measured from the command, so this includes the `ip` command and a CLI start-up per
+        # poll (100-350 ms on a loaded machine): only that it comes soon, not a latency (the
+        # QEMU case 30-link-cut times the first stale reading in-process: 22-25 ms).
+        assert stale < STALE_MS / 1000 + 1.0, stale
         peer_down = wait_for(lambda: not peer_stats(pair.stats("planner"), "control")["alive"], 2)
         assert peer_down is not None
         st = pair.stats("planner")

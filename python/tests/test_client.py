@@ -242,10 +242,12 @@ def test_production_age_never_exact_without_synced_clocks(client: Client) -> Non
     after = Client.now() - r.source_time_ns
     assert a["known"] and a["code"] == "same_node" and a["error_ns"] == 0
     assert before <= a["age_ns"] <= after
+    # ... and its write on the common (realtime) base: the write moved by realtime - monotonic.
+    assert abs(a["production_time_ns"] - (r.source_time_ns + time.time_ns() - Client.now())) < 5_000_000
     remote = client.read("remote_x")
     assert client.production_age("remote_x", remote) == {"known": False, "code": "never", "age_ns": None,
-                                                          "error_ns": None}
+                                                          "error_ns": None, "production_time_ns": None}
     # As if a value had arrived: still unknown, because this board's clock is not synced.
     fake = ccomm.Reading(0.0, ccomm.Status.FRESH, 1, 1000, Client.now() - 1000, 0, False)
     assert client.production_age("remote_x", fake) == {"known": False, "code": "local_unsynced", "age_ns": None,
-                                                        "error_ns": None}
+                                                        "error_ns": None, "production_time_ns": None}

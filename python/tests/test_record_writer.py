@@ -3,6 +3,7 @@
 its receive stamp (a frame that waited in ccommd's socket is stamped with its arrival)."""
 from __future__ import annotations
 
+import json
 import struct
 from pathlib import Path
 
@@ -22,12 +23,13 @@ def signal(sid: int, name: str) -> SignalInfo:
                       produced_here=False, stale_after_ms=0, producer="other", consumed_here=True)
 
 
-def value(sid: int, seq: int, recv_ns: int) -> bytes:
-    return RECORD.pack(sid, 0, 0, seq, recv_ns, recv_ns, 0) + struct.pack("<d", float(seq))
+def value(sid: int, seq: int, recv_ns: int, prod: tuple = (-1, -1, 3)) -> bytes:
+    """A record; `prod`: (production time, its error, age code), default unknown (local_unsynced)."""
+    return RECORD.pack(sid, 0, 0, seq, recv_ns, recv_ns, 0, *prod) + struct.pack("<d", float(seq))
 
 
 def watermark(t_ns: int) -> bytes:
-    return RECORD.pack(WATERMARK_ID, 0, 0, 0, t_ns, 0, 0)
+    return RECORD.pack(WATERMARK_ID, 0, 0, 0, t_ns, 0, 0, -1, -1, 0)
 
 
 def log_times(path: Path) -> list:
@@ -36,9 +38,9 @@ def log_times(path: Path) -> list:
                 mcap_reader.make_reader(f).iter_messages(log_time_order=False)]
 
 
-def write(tmp_path: Path, records: bytes) -> tuple:
+def write(tmp_path: Path, records: bytes, **options: object) -> tuple:
     w = RecordingWriter(WriterOptions(output=str(tmp_path / "w.mcap"), signals=[signal(0, "a"), signal(1, "b")],
-                                      node="monitor", progress="none"))
+                                      node="monitor", progress="none", **options))  # type: ignore[arg-type]
     w._open()
     buf = bytearray(records)
     assert w.add(buf) == len(buf)
@@ -67,3 +69,24 @@ def test_a_value_later_than_the_hold_is_logged_at_the_newest_time_and_counted(tm
     assert w.late == 1 and w.late_max_ns == lag - 1 * MS
     assert w.hold_ns > HOLD_MIN_NS  # widened after it: the next such value is held long enough
     assert w.summary(1.0)["logged_late"] == 1
+
+
+def messages(path: Path) -> list:
+    with open(path, "rb") as f:
+        return [(ch.topic, m.log_time, m.publish_time, m.data) for _s, ch, m in
+                mcap_reader.make_reader(f).iter_messages(log_time_order=False)]
+
+
+@pytest.mark.parametrize("profile", ["ccomm", "ros2"])
+def test_publish_time_is_the_production_time_when_known_else_the_receive_time(tmp_path: Path, profile: str) -> None:
+    t, offset = 1000 * MS, 1_700_000_000_000_000_000  # CLOCK_REALTIME - CLOCK_MONOTONIC at the start
+    produced = offset + t - 40 * MS  # written 40 ms before it arrived, on the common time base
+    write(tmp_path, value(0, 1, t, (produced, 7000, 0)) + value(1, 1, t + 1 * MS)
+          + watermark(t + HOLD_MIN_NS * 2), clock_offset_ns=offset, profile=profile)
+    (a, a_log, a_pub, a_data), (b, b_log, b_pub, b_data) = messages(tmp_path / "w.mcap")
+    assert (a, a_log, a_pub) == ("a" if profile == "ccomm" else "/ccomm/a", offset + t, produced)
+    assert (b_log, b_pub) == (offset + t + 1 * MS, offset + t + 1 * MS)  # unknown: the receive time
+    if profile == "ccomm":
+        ma, mb = json.loads(a_data), json.loads(b_data)
+        assert (ma["production_time_ns"], ma["production_error_ns"], ma["age_code"]) == (produced, 7000, "synced")
+        assert (mb["production_time_ns"], mb["production_error_ns"], mb["age_code"]) == (None, None, "local_unsynced")

@@ -230,6 +230,12 @@ const char* ccomm_clock_state_name(int state) {
   return state >= 0 && state < 4 ? kNames[state] : "?";
 }
 
+const char* ccomm_production_age_name(int code) {
+  static const char* const kNames[] = {"synced", "same_node", "never", "local_unsynced", "producer_unsynced",
+                                       "no_summary"};
+  return code >= 0 && code < 6 ? kNames[code] : "?";
+}
+
 int ccomm_get_daemon_counter(const ccomm_client* c, int index, const char** name, uint64_t* value) {
   static const char* const kNames[] = {
       "frames_rx",         "frames_tx",          "frames_bad",      "frames_wrong_hash",

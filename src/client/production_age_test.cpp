@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <cstdlib>
+
 #include <string>
 
 #include "common/platform.h"
@@ -62,10 +64,11 @@ class ProductionAgeTest : public ::testing::Test {
     return a;
   }
   static void ExpectUnknown(const ccomm_production_age& a, int code) {
-    EXPECT_EQ(a.code, code);
+    EXPECT_EQ(a.code, code) << ccomm_production_age_name(a.code);
     EXPECT_EQ(a.known, 0);
     EXPECT_EQ(a.age_ns, -1);
     EXPECT_EQ(a.error_ns, -1);
+    EXPECT_EQ(a.production_time_ns, -1);
   }
 
   SystemConfig cfg_;
@@ -104,6 +107,8 @@ TEST_F(ProductionAgeTest, KnownOnlyWhenBothClocksAreSynced) {
   EXPECT_EQ(a.error_ns, 2000 + 3000 + 2000);  // both bounds, and reading the two offsets
   EXPECT_GE(a.age_ns, 40 * kMs - a.error_ns);
   EXPECT_LT(a.age_ns, 40 * kMs + 5000 * kMs);  // a loaded machine may pause the test for seconds
+  // The write on the common time base: the producer's stamp moved by its own offset, exactly.
+  EXPECT_EQ(a.production_time_ns, static_cast<int64_t>(info.source_time_ns) + b_offset);
   // A lost clock is no clock: unknown again, not the last good number.
   SetClock(1, 3, kNoBound, b_offset);
   ExpectUnknown(Age(sp, info), CCOMM_PAGE_PRODUCER_UNSYNCED);
@@ -126,6 +131,9 @@ TEST_F(ProductionAgeTest, ValueProducedHereIsExactOnOneClock) {
   EXPECT_EQ(a.error_ns, 0);
   EXPECT_GE(a.age_ns, before);
   EXPECT_LE(a.age_ns, after);
+  // On this board's realtime clock: the write moved by the realtime - monotonic offset.
+  const int64_t want = static_cast<int64_t>(info.source_time_ns) + platform::RealtimeOffsetNs();
+  EXPECT_LE(std::llabs(a.production_time_ns - want), 100000);  // two clock readings apart
 }
 
 TEST_F(ProductionAgeTest, CppViewAndGrowableCallers) {
@@ -159,6 +167,17 @@ TEST_F(ProductionAgeTest, CppViewAndGrowableCallers) {
   EXPECT_EQ(ccomm_view_production_age_sized(view.raw(), sp.id(), &r.info, &big.a, 8), CCOMM_E_INVAL);
   EXPECT_EQ(ccomm_view_production_age(view.raw(), 99, &r.info, &a), CCOMM_E_INVAL);
   EXPECT_EQ(ccomm_view_production_age(view.raw(), sp.id(), nullptr, &a), CCOMM_E_INVAL);
+}
+
+TEST(ProductionAgeName, EveryCodeHasTheNameToolsRecord) {
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_SYNCED), "synced");
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_SAME_NODE), "same_node");
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_NEVER), "never");
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_LOCAL_UNSYNCED), "local_unsynced");
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_PRODUCER_UNSYNCED), "producer_unsynced");
+  EXPECT_STREQ(ccomm_production_age_name(CCOMM_PAGE_NO_SUMMARY), "no_summary");
+  EXPECT_STREQ(ccomm_production_age_name(6), "?");
+  EXPECT_STREQ(ccomm_production_age_name(-1), "?");
 }
 
 }  // namespace

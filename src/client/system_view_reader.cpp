@@ -139,6 +139,7 @@ static int FillProductionAge(const ccomm_view* v, ccomm_signal s, const ccomm_in
   *out = ccomm_production_age{};
   out->age_ns = -1;
   out->error_ns = -1;
+  out->production_time_ns = -1;
   ccomm_signal_desc d;
   if (ccomm_describe(v->client, s, &d) != 0) return CCOMM_E_INVAL;
   if (info->seq == 0) {
@@ -152,6 +153,7 @@ static int FillProductionAge(const ccomm_view* v, ccomm_signal s, const ccomm_in
     out->known = 1;
     out->age_ns = now > source ? now - source : 0;
     out->error_ns = 0;
+    out->production_time_ns = static_cast<int64_t>(ccomm::platform::RealtimeNs()) - out->age_ns;
     return 0;
   }
   const uint32_t producer = ccomm::client::SegmentOf(v->client).dir(static_cast<uint32_t>(s)).producer;
@@ -175,6 +177,7 @@ static int FillProductionAge(const ccomm_view* v, ccomm_signal s, const ccomm_in
   out->code = CCOMM_PAGE_SYNCED;
   out->known = 1;
   out->age_ns = now_common - written;  // may come out below 0 by up to error_ns
+  out->production_time_ns = written;
   out->error_ns = static_cast<int64_t>(self.error_ns + prod.error_ns) + 2 * kOffsetReadingNs;
   return 0;
 }

@@ -14,6 +14,7 @@
 
 namespace ccomm_ros2 {
 
+// kWrite: a sample's production time on the common time base when known, else its arrival.
 enum class StampMode { kWrite, kArrival };
 
 struct Options {
@@ -68,6 +69,8 @@ struct RouteCounters {
   std::atomic<uint64_t> refused_value{0};   // a value the signal's type cannot hold (bool 0/1)
   std::atomic<uint64_t> ccomm_errors{0};    // ccomm_write failed (e.g. event queue full)
   std::atomic<uint64_t> wrong_type_peers{0};  // DDS writers on this topic with another type
+  std::atomic<uint64_t> stamped_production{0};  // samples stamped with their production time
+  std::atomic<uint64_t> stamped_local{0};       // ... with their arrival: production time unknown
 };
 
 struct Route {
@@ -85,6 +88,7 @@ struct Route {
   bool history = false;     // to_ros: a received state read through the node's history tap
   ccomm_history_cursor cursor{};  // ... its cursor (every value, in order)
   uint64_t last_overrun = 0;      // ... the cursor's overrun already counted
+  int stamp_code = -2;            // to_ros: ccomm_production_age_code of the last stamp (-1: no view)
   RouteCounters n;
 };
 
@@ -96,6 +100,9 @@ struct Bridge {
   std::atomic<uint64_t> reopens{0};
   std::atomic<bool> stop{false};
   std::atomic<int> fatal{0};  // non-zero: exit status a worker asks for
+  ccomm_view* to_ros_view = nullptr;  // the ccomm -> ROS 2 thread's system view (production ages)
+  uint32_t view_generation = 0;       // ccommd generation it was opened under
+  int64_t view_recheck_ns = 0;        // when to open it once more after a ccommd restart (0: no)
 
   Bridge() = default;
   Bridge(const Bridge&) = delete;

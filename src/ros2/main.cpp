@@ -180,10 +180,12 @@ void PrintStats(const Bridge* b) {
       const RouteCounters& n = r->n;
       printf("%s\"%s\":{\"dir\":\"%s\",\"published\":%llu,\"skipped\":%llu,\"stale\":%llu,\"lost\":%llu,"
              "\"received\":%llu,\"written\":%llu,\"refused_length\":%llu,\"refused_value\":%llu,"
-             "\"ccomm_errors\":%llu,\"dds_errors\":%llu,\"wrong_type_peers\":%llu}",
+             "\"ccomm_errors\":%llu,\"dds_errors\":%llu,\"wrong_type_peers\":%llu,"
+             "\"stamped_production\":%llu,\"stamped_local\":%llu}",
              first ? "" : ",", r->name.c_str(), r->to_ros ? "to_ros" : "from_ros", g(n.published),
              g(n.skipped), g(n.stale), g(n.lost), g(n.received), g(n.written), g(n.refused_length),
-             g(n.refused_value), g(n.ccomm_errors), g(n.dds_errors), g(n.wrong_type_peers));
+             g(n.refused_value), g(n.ccomm_errors), g(n.dds_errors), g(n.wrong_type_peers),
+             g(n.stamped_production), g(n.stamped_local));
       first = false;
     }
   printf("}}\n");

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccomm -> ROS 2: wakes on every change of the node's signals (ccomm_wait), reads each
 // published signal straight into its preallocated DDS sample and writes it with the
-// ccomm write time as source timestamp. Nothing is allocated per sample here. A state
-// this node receives is read through the history tap when the node has one
-// (<node history="N">): every value is published, not only the newest at each wake-up.
+// value's production time as source timestamp (docs/integrations/ros2.md, "Time").
+// Nothing is allocated per sample here. A state this node receives is read through the
+// history tap when the node has one (<node history="N">): every value is published, not
+// only the newest at each wake-up.
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -26,13 +27,40 @@ int64_t WallNow() {
   return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
-// Source timestamp of a value (DDS, like ROS 2, stamps with the wall clock; ccomm with
-// CLOCK_MONOTONIC): the write time, or the arrival time, moved to the wall clock.
-dds_time_t SourceTime(const Bridge* b, const ccomm_info& info) {
-  const int64_t wall = WallNow(), mono = ccomm_now();
-  if (b->opt.stamp == StampMode::kArrival || info.source_time_ns == 0)
-    return wall - (info.age_ns > 0 ? info.age_ns : 0);
-  return wall - (mono - static_cast<int64_t>(info.source_time_ns));
+// Says once per change which time a route's samples carry (not per sample: a stamp kind
+// changes when a clock's state does, seconds apart at most).
+void NoteStampKind(const Bridge* b, Route* r, int code) {
+  if (code == r->stamp_code) return;
+  const bool was_known = r->stamp_code == CCOMM_PAGE_SYNCED || r->stamp_code == CCOMM_PAGE_SAME_NODE;
+  const bool known = code == CCOMM_PAGE_SYNCED || code == CCOMM_PAGE_SAME_NODE;
+  const bool first = r->stamp_code == -2;
+  r->stamp_code = code;
+  if (!first && was_known == known && !b->opt.verbose) return;
+  if (known)
+    fprintf(stderr, "ccomm-ros2: %s: source timestamps are production times (%s)\n", r->name.c_str(),
+            ccomm_production_age_name(code));
+  else
+    fprintf(stderr, "ccomm-ros2: %s: source timestamps are local, the arrival here: production time unknown (%s)\n",
+            r->name.c_str(), code < 0 ? "no system view" : ccomm_production_age_name(code));
+}
+
+// Source timestamp of a value (DDS, like ROS 2, stamps with the wall clock, CLOCK_REALTIME):
+// when the value was written on its producer, on the common time base, where that is
+// known (both boards' clocks synced, or produced on this board); else, and with
+// --stamp arrival, when it reached this node (its local age before now), counted.
+dds_time_t SourceTime(Bridge* b, Route* r, const ccomm_info& info) {
+  if (b->opt.stamp == StampMode::kWrite) {
+    ccomm_production_age pa{};
+    int code = -1;
+    if (b->to_ros_view && ccomm_view_production_age(b->to_ros_view, r->id, &info, &pa) == 0) code = pa.code;
+    NoteStampKind(b, r, code);
+    if (code >= 0 && pa.known) {
+      r->n.stamped_production.fetch_add(1, std::memory_order_relaxed);
+      return pa.production_time_ns;
+    }
+  }
+  r->n.stamped_local.fetch_add(1, std::memory_order_relaxed);
+  return WallNow() - (info.age_ns > 0 ? info.age_ns : 0);
 }
 
 // Where ccomm_read puts the value: the sample itself (scalars) or its data buffer.
@@ -41,7 +69,7 @@ void* ValueOf(Route* r) {
 }
 
 bool Publish(Bridge* b, Route* r, const ccomm_info& info) {
-  const dds_time_t ts = SourceTime(b, info);
+  const dds_time_t ts = SourceTime(b, r, info);
   // A reliable KEEP_ALL (event) writer blocks up to 100 ms while a reader's history is
   // full; retry so no event is dropped for a slow reader that is still there.
   for (int attempt = 0; attempt < 50; ++attempt) {
@@ -147,6 +175,34 @@ void StartRoutes(ccomm_client* c, const std::vector<Route*>& routes) {
   }
 }
 
+// The system view gives production ages (the node summaries' clocks). Without one (a
+// ccommd older than the view) every sample is stamped with its arrival, said once.
+void OpenView(Bridge* b, ccomm_client* c, bool quiet = false) {
+  b->view_generation = ccomm_daemon_generation(c);
+  const int rc = ccomm_view_open(c, &b->to_ros_view);
+  if (rc != 0) {
+    b->to_ros_view = nullptr;
+    if (!quiet)
+      fprintf(stderr, "ccomm-ros2: no system view (%s): source timestamps are arrival times\n", ccomm_strerror(rc));
+  }
+}
+void CloseView(Bridge* b) {
+  if (b->to_ros_view) ccomm_view_close(b->to_ros_view);
+  b->to_ros_view = nullptr;
+}
+// A ccommd restarted on the same configuration keeps the segment but makes a new view
+// (the old one stops: its clocks would time out, every stamp local). It adopts the
+// segment (generation + 1) just before it creates the view, so the view is opened again
+// when the generation changes and once more 2 s later, in case the first came between.
+void FollowView(Bridge* b, ccomm_client* c) {
+  const int64_t now = ccomm_now();
+  const bool restarted = ccomm_daemon_generation(c) != b->view_generation;
+  if (!restarted && (b->view_recheck_ns == 0 || now < b->view_recheck_ns)) return;
+  b->view_recheck_ns = restarted ? now + 2000000000 : 0;
+  CloseView(b);
+  OpenView(b, c, /*quiet=*/restarted);
+}
+
 }  // namespace
 
 void RunToRos(Bridge* b) {
@@ -169,8 +225,10 @@ void RunToRos(Bridge* b) {
   for (size_t i = 0; offered && i < b->to_ros.size(); ++i) offered &= OfferCurrentDeadline(b, b->to_ros[i], offered_ms[i]);
   if (!offered) { b->fatal = 1; b->stop = true; ccomm_close(c); return; }
   StartRoutes(c, b->to_ros);
+  OpenView(b, c);
   while (!b->stop.load(std::memory_order_relaxed)) {
     ccomm_wait(c, 100);  // returns at once on a change; 100 ms to notice stop/retirement
+    FollowView(b, c);
     int err = 0;
     for (Route* r : b->to_ros) {
       err = Pump(b, c, r);
@@ -179,6 +237,7 @@ void RunToRos(Bridge* b) {
     if (err == CCOMM_E_RETIRED || err == CCOMM_E_VERSION) {
       // ccommd replaced the segment (restart with a new configuration): attach anew.
       if (b->opt.verbose) fprintf(stderr, "ccomm-ros2: segment retired, reopening\n");
+      CloseView(b);
       ccomm_close(c);
       c = OpenWaiting(b);
       if (!c) return;
@@ -191,12 +250,14 @@ void RunToRos(Bridge* b) {
       if (!offered) { b->fatal = 1; b->stop = true; break; }
       b->reopens.fetch_add(1, std::memory_order_relaxed);
       StartRoutes(c, b->to_ros);  // a new segment counts anew
+      OpenView(b, c);
     } else if (err < 0) {
       fprintf(stderr, "ccomm-ros2: reading signals: %s\n", ccomm_strerror(err));
       b->fatal = 1;
       b->stop = true;
     }
   }
+  CloseView(b);
   if (c) ccomm_close(c);
 }
 

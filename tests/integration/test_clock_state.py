@@ -132,7 +132,8 @@ def test_clock_states_none_synced_syncing_lost():
             got = run_python(pair, "planner", PY_AGE)
             assert got["seq"] > 0, got
             if clock_state(pair, "planner")["state"] != "synced":
-                assert got["age"] == {"known": False, "code": "local_unsynced", "age_ns": None, "error_ns": None}, got
+                assert got["age"] == {"known": False, "code": "local_unsynced", "age_ns": None, "error_ns": None,
+                                      "production_time_ns": None}, got
             # ptp4l killed: lost within its two missed polls (plus a loaded machine's delay).
             ptp["planner"].send_signal(signal.SIGKILL)
             ptp["planner"].wait()

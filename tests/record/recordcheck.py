@@ -81,6 +81,41 @@ def check_order(path: str) -> int:
     return 0 if n > 0 and back == 0 else 1
 
 
+def check_stamps(path: str, expect: str) -> int:
+    """Each message's production time (issue 29) as the recorder's node could know it:
+    expect "local" (no clock synchronisation: age_code local_unsynced, no production time
+    or error, MCAP publish time = the receive time in Unix time) or "same_node" (values of
+    the recording node: error 0, production time = source time + the node's realtime -
+    monotonic offset, within 1 ms, and the MCAP publish time = the production time)."""
+    n, bad, first = 0, 0, ""
+    with open(path, "rb") as f:
+        r = make_reader(f)
+        offset = None
+        for rec in r.iter_metadata():
+            if rec.name == "ccomm":
+                offset = int(rec.metadata["clock_offset_ns"])
+        f.seek(0)
+        for _schema, channel, message in make_reader(f).iter_messages(log_time_order=False):
+            m = json.loads(message.data)
+            n += 1
+            if expect == "local":
+                ok = (m["age_code"] == "local_unsynced" and m["production_time_ns"] is None and
+                      m["production_error_ns"] is None and message.publish_time == m["receive_time_ns"] + offset)
+            else:
+                ok = (m["age_code"] == "same_node" and m["production_error_ns"] == 0 and
+                      abs(m["production_time_ns"] - (m["source_time_ns"] + offset)) < 1_000_000 and
+                      message.publish_time == m["production_time_ns"])
+            if not ok:
+                bad += 1
+                if not first:
+                    first = "%s: %s (publish time %d, clock offset %s)" % (
+                        channel.topic, {k: m.get(k) for k in ("age_code", "production_time_ns", "production_error_ns",
+                                                               "source_time_ns", "receive_time_ns")},
+                        message.publish_time, offset)
+    print("# %d messages, %d not stamped as %s%s" % (n, bad, expect, "; first: " + first if bad else ""))
+    return 0 if n > 0 and bad == 0 else 1
+
+
 def check_initial(path: str, signal: str, max_span_s: float) -> int:
     """A recording started on a running system: `signal`'s first message is its value from
     before the start, marked initial and logged at the start; every message lies within
@@ -353,13 +388,15 @@ def small_recording(path: str) -> None:
     w = RecordingWriter(WriterOptions(output=path, signals=sigs, node="a", chunk_size=2048))
     w._open()
     buf = bytearray()
+    unknown = (-1, -1, 3)  # production time unknown (local_unsynced)
     for k in range(1, 201):
         t = 1_000_000 * k
-        buf += RECORD.pack(0, 0, 0, k, t + 50, t, 0) + struct.pack("<d", k / 3)
-        buf += RECORD.pack(1, 1, 0, k, t + 50, t, 0) + struct.pack("<4d", k, float("nan"), float("inf"), -k)
-        buf += RECORD.pack(2, 0, 0, k, t + 50, t, 0) + struct.pack("<i", -k)
+        produced = (1_700_000_000_000_000_000 + t, 0, 1)  # same_node: known, exact
+        buf += RECORD.pack(0, 0, 0, k, t + 50, t, 0, *produced) + struct.pack("<d", k / 3)
+        buf += RECORD.pack(1, 1, 0, k, t + 50, t, 0, *unknown) + struct.pack("<4d", k, float("nan"), float("inf"), -k)
+        buf += RECORD.pack(2, 0, 0, k, t + 50, t, 0, *produced) + struct.pack("<i", -k)
         if k % 10 == 0:
-            buf += RECORD.pack(3, 0, 0, k // 10, t + 50, t, 0) + struct.pack("<?", k % 20 == 0)
+            buf += RECORD.pack(3, 0, 0, k // 10, t + 50, t, 0, *unknown) + struct.pack("<?", k % 20 == 0)
     assert w.add(buf) == len(buf)
     w._close()
 
@@ -461,6 +498,8 @@ def main() -> int:
     cmd, args = sys.argv[1], sys.argv[2:]
     if cmd == "ros2":  # FILE CONFIG NODE
         return check_ros2(sys.argv[2], sys.argv[3], sys.argv[4])
+    if cmd == "stamps":  # FILE local|same_node
+        return check_stamps(sys.argv[2], sys.argv[3])
     if cmd == "order":  # FILE
         return check_order(sys.argv[2])
     if cmd == "initial":  # FILE SIGNAL MAX_SPAN_S

@@ -94,9 +94,9 @@ sweep_stale
 # `ip netns exec` execs the command, so $! (also kept in PIDS) is the command itself and
 # a signal to it reaches the program, not a wrapper shell.
 spawn() {
-  local log=$1 ns
-  ns=$(ns_of "$2")
-  ip netns exec "$ns" "${@:3}" >"$log" 2>&1 &
+  local log=$1
+  ns_cmd "$2"
+  "${NS_CMD[@]}" "${@:3}" >"$log" 2>&1 &
   PIDS+=($!)
 }
 
@@ -157,13 +157,26 @@ static_neighbours() {
   ip -n "$NS_P" neigh replace 10.42.0.1 lladdr "$mac_c" dev eth0 nud permanent
 }
 ns_of() { [[ $1 = control ]] && echo "$NS_C" || echo "$NS_P"; }
+# ns_cmd NODE: NS_CMD=(the prefix that runs a program in NODE's network namespace and,
+# when the suite gives the node a clock of its own, NODE_MONO_SHIFT_S[NODE]=SECONDS, in a
+# time namespace whose CLOCK_MONOTONIC is that far ahead: a board whose monotonic clock is
+# not this host's). Both `ip netns exec` and `unshare` exec the program: in the
+# background, $! is the program itself.
+declare -A NODE_MONO_SHIFT_S
+ns_cmd() {
+  NS_CMD=(ip netns exec "$(ns_of "$1")")
+  [[ -n ${NODE_MONO_SHIFT_S[$1]:-} ]] && NS_CMD+=(unshare --time --monotonic "${NODE_MONO_SHIFT_S[$1]}")
+  return 0
+}
+ns_exec() { local node=$1; shift; ns_cmd "$node"; "${NS_CMD[@]}" "$@"; }  # ns_exec NODE COMMAND...
 
 # ---- daemons and clients ------------------------------------------------------------------
 declare -A DPID
 start_daemon() {  # start_daemon NODE [extra ccommd args]: waits until its segment is ready
   local node=$1; shift
   local log=$WORK/ccommd-$node.log
-  ip netns exec "$(ns_of "$node")" "$BIN/ccommd" --node "$node" --no-rt -c "${DAEMON_CONFIG:-$CONFIG}" "$@" \
+  ns_cmd "$node"
+  "${NS_CMD[@]}" "$BIN/ccommd" --node "$node" --no-rt -c "${DAEMON_CONFIG:-$CONFIG}" "$@" \
     >>"$log" 2>&1 &
   DPID[$node]=$!
   PIDS+=($!)
@@ -182,8 +195,8 @@ stop_daemon() {  # SIGTERM, wait; returns ccommd's exit status
   wait "$p" 2>/dev/null
 }
 daemon_alive() { kill -0 "${DPID[$1]}" 2>/dev/null; }
-cli() { local node=$1; shift; ip netns exec "$(ns_of "$node")" "$BIN/ccomm" --node "$node" "$@"; }
-in_ns() { local node=$1; shift; ip netns exec "$(ns_of "$node")" "$@"; }
+cli() { local node=$1; shift; ns_exec "$node" "$BIN/ccomm" --node "$node" "$@"; }
+in_ns() { ns_exec "$@"; }
 
 # stats NODE: ccomm stats --json into $WORK/stats-NODE.json; jq-free accessors below.
 # (--watch prints its first snapshot after 5 ms; a one-shot stats waits 200 ms for rates.)

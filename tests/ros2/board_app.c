@@ -3,8 +3,10 @@
  * board_app: the application on board A (or any node) in the ROS 2 bridge tests, a plain
  * client of the public ccomm C API.
  *
- *   board_app pub SIGNAL N HZ     write N values at HZ (0: as fast as the queue allows),
- *                                 never closer than half a period
+ *   board_app pub SIGNAL N HZ [AGO_MS]  write N values at HZ (0: as fast as the queue
+ *                                 allows), never closer than half a period; with AGO_MS
+ *                                 each is stamped as written AGO_MS before it is handed to
+ *                                 ccomm (a value produced earlier: a known production age)
  *   board_app watch SIGNAL N SEC  print the first N new values (state) / events within SEC
  *
  * Values are made so a reader can check each element and the write time: element 0 is
@@ -58,8 +60,9 @@ static void sleep_until(int64_t t) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 5 || (strcmp(argv[1], "pub") && strcmp(argv[1], "watch"))) {
-    fprintf(stderr, "usage: board_app pub SIGNAL N HZ | board_app watch SIGNAL N SECONDS\n");
+  if (argc < 5 || argc > 6 || (strcmp(argv[1], "pub") && strcmp(argv[1], "watch")) ||
+      (argc == 6 && strcmp(argv[1], "pub"))) {
+    fprintf(stderr, "usage: board_app pub SIGNAL N HZ [AGO_MS] | board_app watch SIGNAL N SECONDS\n");
     return 2;
   }
   ccomm_client* c;
@@ -74,6 +77,7 @@ int main(int argc, char** argv) {
   if (d.value_bytes > sizeof buf) return 1;
   if (!strcmp(argv[1], "pub")) {
     int64_t period = arg > 0 ? (int64_t)(1e9 / arg) : 0, next = ccomm_now();
+    const int64_t ago = argc == 6 ? (int64_t)(atof(argv[5]) * 1e6) : 0;
     long written = 0;
     for (long k = 1; k <= n; ++k) {
       if (period) {
@@ -84,7 +88,7 @@ int main(int argc, char** argv) {
         int64_t now = ccomm_now();
         next = next + period > now + period / 2 ? next + period : now + period / 2;
       }
-      int64_t t = ccomm_now();
+      int64_t t = ccomm_now() - ago;
       ccomm_set_time(c, t);  /* the value's ccomm write time is exactly t */
       fill(&d, (uint64_t)k, t, buf);
       for (;;) {

@@ -18,6 +18,41 @@ a_to_ros() {  # a_to_ros SIGNAL ROS_TYPE CCOMM_TYPE COUNT N [--event]
     --mono-minus-wall "$(mono_minus_wall "$sig")"
 }
 check "A -> ROS 2: double scalar (Float64), value and source timestamp = ccomm write time" a_to_ros pos Float64 double 1 20
+
+# ---- the source timestamp is the value's production time on the common time base
+# Values stamped as produced 300 ms before board A's app hands them to ccomm (a sensor's
+# sample time): a bridge stamping its own write time or the arrival is 300 ms late.
+produced_ago() {  # produced_ago SIGNAL N AGO_MS [checks samples args]: A writes N, B's reader checks stamps
+  local sig=$1 n=$2 ago=$3; shift 3
+  echo_start "$sig-ago" "$sig" Float64 --count "$n" --timeout 20 || return 1
+  app pub "$sig" "$n" 50 "$ago" >"$WORK/$sig-ago.app" || return 1
+  wait "$ECHO_PID" || { cat "$WORK/$sig-ago.result"; return 1; }
+  checks samples "$WORK/$sig-ago.jsonl" --n "$n" --type double --count 1 \
+    --mono-minus-wall "$(mono_minus_wall "$sig-ago")" "$@"
+}
+grew_by() {  # grew_by BEFORE AFTER N: two counters read from the bridge, AFTER = BEFORE + N
+  [[ $1 =~ ^[0-9]+$ && $2 =~ ^[0-9]+$ ]] && (( $2 - $1 == $3 ))
+}
+p0=$(bridge_stat pos stamped_production); l0=$(bridge_stat pos stamped_local)
+check "A -> ROS 2: values produced 300 ms before A's app wrote them carry their production time (+/- 2 ms), on B's wall clock although A's monotonic clock is $(( MONO_SHIFT_NS / 1000000000 )) s ahead" \
+  produced_ago pos 20 300
+p1=$(bridge_stat pos stamped_production); l1=$(bridge_stat pos stamped_local)
+check "  ... all 20 stamped from production ($p0 -> $p1), none locally ($l0 -> $l1)" \
+  bash -c "$(declare -f grew_by); grew_by '$p0' '$p1' 20 && grew_by '$l0' '$l1' 0"
+# B's clock not synced (its ptp4l killed: lost): the production time is unknown; the stamp
+# is the arrival (300 ms after the production), counted, and the bridge says so.
+if [[ -n ${PTP_PID[planner]:-} ]]; then
+  kill -9 "${PTP_PID[planner]}"; wait "${PTP_PID[planner]}" 2>/dev/null
+  b_clock_lost() { [[ $(clock_of planner planner) = lost ]]; }  # in the view the bridge asks
+  check "B's ptp4l killed: B's clock lost" wait_for 30 b_clock_lost
+  check "  ... then values carry their arrival on B as source timestamp (300 ms after production, +/- 100 ms)" \
+    produced_ago pos 20 300 --stamp-offset-ms 300 --stamp-tolerance-ms 100
+  l2=$(bridge_stat pos stamped_local)
+  check "  ... each counted as stamped_local ($l1 -> $l2) and the bridge's log says that stamps are local" \
+    bash -c "$(declare -f grew_by); grew_by '$l1' '$l2' 20 && grep -q 'pos: source timestamps are local, the arrival here: production time unknown (local_unsynced)' '$BRIDGE_LOG'"
+  start_ptp4l planner UDPv4
+  check "  ... B's ptp4l restarted: both clocks synced again" wait_for 60 both_synced
+fi
 check "A -> ROS 2: int32[3] (Int32MultiArray)" a_to_ros counts Int32MultiArray int32 3 20
 check "A -> ROS 2: uint32 (UInt32)" a_to_ros ticks UInt32 uint32 1 20
 check "A -> ROS 2: int64 (Int64)" a_to_ros big Int64 int64 1 20
@@ -167,6 +202,13 @@ stop_daemon planner
 start_rt_daemon planner
 sleep 0.3
 check "after a ccommd restart on B (same configuration) values flow both ways" flows
+production_again() {  # the restarted ccommd has a new system view: the bridge follows it
+  wait_for 60 both_synced || { note "clocks not synced again"; return 1; }
+  local p0; p0=$(bridge_stat pos stamped_production)
+  produced_ago pos 20 300 && grew_by "$p0" "$(bridge_stat pos stamped_production)" 20
+}
+check "  ... and once B's clock is synced again, source timestamps are production times again (the bridge opened the new ccommd's view)" \
+  production_again
 # The new configuration also changes pos's stale_after_ms (50 -> 120 ms): the bridge must
 # offer the new deadline after it reattaches.
 sed -e 's|</ccomm>|  <signal name="extra" type="double" producer="control" consumers="planner"/>\n</ccomm>|' \

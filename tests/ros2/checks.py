@@ -5,7 +5,9 @@
   checks.py samples FILE --n N --type T --count C --mono-minus-wall NS
       FILE (ros_peer.py echo --out) holds exactly the values k = 1..N that board_app pub
       wrote (element 0 = k, other elements k*1000+i, doubles carry the write time) in
-      order, none twice, and each DDS source timestamp is the ccomm write time
+      order, none twice, and each DDS source timestamp is the ccomm write time, as the
+      producer's --mono-minus-wall NS (CLOCK_MONOTONIC - CLOCK_REALTIME there) puts it on
+      the wall clock (--stamp-offset-ms X: X ms after it, +/- --stamp-tolerance-ms)
   checks.py watch FILE --expect JSON
       board_app watch output: one FRESH line per expected value, in order
   checks.py stats LOG SIGNAL FIELD
@@ -28,6 +30,7 @@ def cmd_samples(a):
     rows = [json.loads(line) for line in open(a.file)]
     errors = []
     ks = []
+    skews = []
     for r in rows:
         data = r["data"] if isinstance(r["data"], list) else [r["data"]]
         data = [int(x) if isinstance(x, bool) else x for x in data]
@@ -37,10 +40,13 @@ def cmd_samples(a):
         if a.type == "double":
             t = int(data[0] if a.count == 1 else data[1])
             k = None if a.count == 1 else int(data[0])
-            # source timestamp (wall) = write time (monotonic) moved to the wall clock
+            # source timestamp (wall) = write time (the producer's monotonic clock) moved to
+            # the wall clock (plus --stamp-offset-ms: an arrival stamp is that much later)
             skew_ms = (r["src_ts"] - (t - a.mono_minus_wall)) / 1e6
-            if abs(skew_ms) > a.stamp_tolerance_ms:
-                errors.append("source timestamp %.3f ms off the write time" % skew_ms)
+            skews.append(skew_ms)
+            if abs(skew_ms - a.stamp_offset_ms) > a.stamp_tolerance_ms:
+                errors.append("source timestamp %.3f ms off the write time (want %.1f +/- %.1f)"
+                              % (skew_ms, a.stamp_offset_ms, a.stamp_tolerance_ms))
         else:
             t, k = 0, int(data[0])
         if a.type == "bool":
@@ -60,7 +66,12 @@ def cmd_samples(a):
         errors.append("%d values, want %d" % (len(rows), a.n))
     for e in errors[:10]:
         print("#   " + e)
-    print("# %d samples checked, %d problems" % (len(rows), len(errors)))
+    stamps = ""
+    if skews:
+        skews.sort()
+        stamps = "; source timestamp - write time: median %.3f ms, range %.3f .. %.3f ms" % (
+            skews[len(skews) // 2], skews[0], skews[-1])
+    print("# %d samples checked, %d problems%s" % (len(rows), len(errors), stamps))
     return 1 if errors else 0
 
 
@@ -107,6 +118,7 @@ def main():
     s.add_argument("--count", type=int, default=1)
     s.add_argument("--mono-minus-wall", type=int, default=0)
     s.add_argument("--stamp-tolerance-ms", type=float, default=2.0)
+    s.add_argument("--stamp-offset-ms", type=float, default=0.0)
     w = sub.add_parser("watch")
     w.add_argument("file")
     w.add_argument("--expect", required=True)

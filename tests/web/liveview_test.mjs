@@ -84,8 +84,9 @@ await check("protocol client: every signal advertised as a JSON channel with a j
     assert(ch, "advertised: " + t);
     assert(ch.encoding === "json" && ch.schemaEncoding === "jsonschema", t + ": " + ch.encoding + "/" + ch.schemaEncoding);
     const schema = JSON.parse(ch.schema);
-    // the fields of a `ccomm record` recording, plus age_ns
-    for (const f of ["value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status", "fresh", "safe_value", "lost", "gap"]) {
+    // the fields of a `ccomm record` recording, plus age_ns and production_age_ns
+    for (const f of ["value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status", "fresh", "safe_value", "lost", "gap",
+                     "production_time_ns", "production_error_ns", "age_code", "production_age_ns"]) {
       assert(schema.properties[f] && schema.required.includes(f), t + " schema lacks " + f);
     }
   }
@@ -154,6 +155,23 @@ await check("the plot follows a value written with ccomm pub (DOM, plot data and
   assert((await canvasPixels(page, "wheel_pos")) !== before, "the chart's pixels did not change");
   const m = await probe.waitFor("wheel_pos", (m) => m.value === -2.5, 3000, "value -2.5");
   assert(m.status === "fresh" && m.seq >= 2, JSON.stringify(m));
+});
+
+await check("the age column: production age ± its error when known (a value of this node: ±0 ns), else the local age marked local", async () => {
+  const m = await probe.waitFor("wheel_pos", (m) => m.value === -2.5, 3000, "value -2.5");
+  assert(m.age_code === "same_node" && m.production_error_ns === 0 && m.production_age_ns >= 0 &&
+         Math.abs(m.production_time_ns - (Date.now() * 1e6 - m.production_age_ns)) < 5e9, JSON.stringify(m));
+  const cell = () => page.evaluate(() => { const td = document.querySelector('#signals tr[data-signal="wheel_pos"] .age');
+    return { text: td.textContent, local: td.classList.contains("local"), title: td.title }; });
+  const c = await until(async () => { const c = await cell(); return / ±0 ns$/.test(c.text) && c; }, 3000, "wheel_pos age ±0 ns");
+  assert(!c.local && c.title.includes("production age (same_node)"), JSON.stringify(c));
+  // The cases a one-node page cannot produce, through the page's own formatting.
+  const local = await page.evaluate(() => window.ccommView.ageCell(
+    { age_ns: 1.25e6, production_age_ns: null, production_error_ns: null, age_code: "local_unsynced" }));
+  assert(local.text === "1.3 ms local" && local.local && local.title.includes("local_unsynced"), JSON.stringify(local));
+  const synced = await page.evaluate(() => window.ccommView.ageCell(
+    { age_ns: 1e6, production_age_ns: 41.2e6, production_error_ns: 2000, age_code: "synced" }));
+  assert(synced.text === "41.2 ms ±2.0 µs" && !synced.local, JSON.stringify(synced));
 });
 
 await check("a signal that is not written goes stale: badge and protocol message say so", async () => {

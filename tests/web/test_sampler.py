@@ -32,9 +32,10 @@ def test_schema_per_type(client):
     joint = json_schema(infos["joint_pos"])
     assert joint["properties"]["value"]["items"] == {"type": ["number", "null"]}
     assert joint["properties"]["value"]["maxItems"] == 3 and joint["title"] == "ccomm.double[3]"
-    # the fields of a `ccomm record` recording, plus age_ns
+    # the fields of a `ccomm record` recording, plus age_ns and production_age_ns
     assert set(joint["required"]) == {"value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status",
-                                      "fresh", "safe_value", "lost", "gap"}
+                                      "fresh", "safe_value", "lost", "gap", "production_time_ns",
+                                      "production_error_ns", "age_code", "production_age_ns"}
     assert topic_of("tick") == "tick"
 
 
@@ -51,7 +52,35 @@ def test_message_fields_and_non_finite_values(client):
     assert message_of(client.read("wheel_pos"), now)["value"] is None
     never = message_of(client.read("unused_sp"), now)
     assert never == {"value": 0.0, "seq": 0, "source_time_ns": None, "receive_time_ns": None, "age_ns": None,
-                     "status": "never", "fresh": False, "safe_value": True, "lost": 0, "gap": 0}  # safe_value="0"
+                     "status": "never", "fresh": False, "safe_value": True, "lost": 0, "gap": 0,  # safe_value="0"
+                     "production_time_ns": None, "production_error_ns": None, "age_code": "no_summary",
+                     "production_age_ns": None}
+
+
+def test_production_age_when_known_else_marked_unknown(client):
+    # A value produced on this node: its production age is exact (one clock), +/- 0.
+    s, sent = sampler(client, ["tick"])
+    client.write("tick", 7)
+    before = client.now()
+    s.poll()
+    after = client.now()
+    m = sent[-1][1]
+    r = client.read("tick")
+    assert m["age_code"] == "same_node" and m["production_error_ns"] == 0
+    assert before - r.source_time_ns <= m["production_age_ns"] <= after - r.source_time_ns
+    assert abs(m["production_time_ns"] - (r.source_time_ns + time.time_ns() - client.now())) < 5_000_000
+    s.close()
+    # A value from a board whose clock is not synced (the code the view gives then): no
+    # production age, never a number; the page shows the local age_ns, marked local.
+    unsynced = ccomm._native.ProductionAge(code=3, known=0, age_ns=-1, error_ns=-1, production_time_ns=-1)
+    m = message_of(r, client.now(), 0, unsynced)
+    assert (m["production_age_ns"], m["production_error_ns"], m["production_time_ns"], m["age_code"]) == \
+        (None, None, None, "local_unsynced")
+    assert m["age_ns"] is not None
+    synced = ccomm._native.ProductionAge(code=0, known=1, age_ns=41_000_000, error_ns=2000, production_time_ns=123)
+    m = message_of(r, client.now(), 0, synced)
+    assert (m["production_age_ns"], m["production_error_ns"], m["production_time_ns"], m["age_code"]) == \
+        (41_000_000, 2000, 123, "synced")
 
 
 def test_publishes_changes_only_then_keepalive(client):

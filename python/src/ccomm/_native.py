@@ -155,8 +155,8 @@ class ViewCounters(ctypes.Structure):
 
 class ProductionAge(ctypes.Structure):
     """ccomm_production_age."""
-    _fields_ = [("code", ctypes.c_int32), ("known", ctypes.c_int32),
-                ("age_ns", ctypes.c_int64), ("error_ns", ctypes.c_int64)]
+    _fields_ = [("code", ctypes.c_int32), ("known", ctypes.c_int32), ("age_ns", ctypes.c_int64),
+                ("error_ns", ctypes.c_int64), ("production_time_ns", ctypes.c_int64)]
 
 
 # The public structs of ccomm.h by their C name: what the layout test compares.
@@ -306,12 +306,14 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_set_time": ([vp, i64], c_int),
         "ccomm_now": ([], i64),
         "ccomm_daemon_alive": ([vp], c_int),
+        "ccomm_daemon_generation": ([vp], u32),
         "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),
         "ccomm_node_count": ([vp], c_int),
         "ccomm_get_peer_stats_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_peer_clock_sized": ([vp, c_int, vp, sz], c_int),
         "ccomm_get_clock_state_sized": ([vp, vp, sz], c_int),
         "ccomm_clock_state_name": ([c_int], cp),
+        "ccomm_production_age_name": ([c_int], cp),
         "ccomm_view_open": ([vp, ctypes.POINTER(vp)], c_int),
         "ccomm_view_close": ([vp], None),
         "ccomm_view_get_node_sized": ([vp, c_int, vp, sz], c_int),

@@ -424,7 +424,8 @@ class Client:
     def production_age(self, name: str, reading: Reading) -> Dict[str, Any]:
         """How long ago the producer wrote the value `reading` (a read of signal `name`)
         holds, on the boards' common (PTP) time base, as of now: {"known", "code",
-        "age_ns", "error_ns"}. known is False, age_ns and error_ns None, unless both
+        "age_ns", "error_ns", "production_time_ns"} (the write on the common base:
+        CLOCK_REALTIME ns). known is False, the numbers None, unless both
         clocks are synced (code "synced": the age is within +/- error_ns) or the value was
         produced on this node ("same_node": exact). docs/design.md, "Time"."""
         sig = self.signal(name)

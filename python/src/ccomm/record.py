@@ -28,7 +28,7 @@ import time
 from typing import Any, Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
-from . import _native
+from . import _native, _view
 from ._errors import E_CORRUPT, CcommError, error_text
 from .client import Client, SignalInfo
 from .mcap_io.schema import FLAG_INITIAL, RECORD, WATERMARK_ID
@@ -47,7 +47,9 @@ Every value of the states the node receives needs its history tap, signals.xml:
 
 Open the file in Foxglove or PlotJuggler, or read it with the `mcap` Python package:
 one channel per signal (topic = signal name), JSON messages with value, seq,
-source_time_ns, receive_time_ns, status, lost and gap. See docs/integrations/record.md.
+source_time_ns, receive_time_ns, status, lost, gap and the production time on the boards'
+common (PTP) time base when known (production_time_ns, production_error_ns, age_code;
+also the MCAP publish time, else the receive time). See docs/integrations/record.md.
 Exit status: 0 done, 1 runtime error, 2 bad arguments or selection.
 """
 
@@ -182,6 +184,28 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
     hinfo_addr = ctypes.addressof(hinfo)
     unpack_hinfo = struct.Struct(_native.unpack_format(_native.HistoryInfo)).unpack_from
     pack = RECORD.pack
+    # Each value's production time on the common time base (ccomm_view_production_age),
+    # with the view opened once; preallocated structs, one foreign call per value.
+    try:
+        ages: Optional[_view.ProductionAges] = _view.ProductionAges(handle)
+    except CcommError as e:  # a ccommd without the system view: no production times
+        print(f"record: no system view ({e}): production times unknown (age_code no_summary)", file=sys.stderr)
+        ages = None
+    production_age = L.ccomm_view_production_age_sized
+    page = _native.ProductionAge()
+    page_addr, page_size = ctypes.addressof(page), ctypes.sizeof(page)
+    unpack_page = struct.Struct(_native.unpack_format(_native.ProductionAge)).unpack_from
+    hist_info = _native.Info()  # a history read's seq and source time, for the age call
+    hist_info_addr = ctypes.addressof(hist_info)
+
+    def production(sid: int, info_at: int) -> Any:
+        # (production time or -1, its error or -1, age code); an error gives "no_summary"
+        view_ptr = ages.raw if ages is not None else None
+        if view_ptr is None or production_age(view_ptr, sid, info_at, page_addr, page_size) != 0:
+            return -1, -1, 5
+        code, known, _age, err, ptime = unpack_page(page)
+        return (ptime, err, code) if known else (-1, -1, code)
+
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
     # A history cursor per received state when the node keeps history (from the newest
     # value kept: what polling would have read first), else None.
@@ -231,8 +255,9 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                     elif seq > prev + 1:
                         lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
                     last_seq[i], last_overrun[i] = seq, overrun
+                    hist_info.seq, hist_info.source_time_ns = seq, src
                     out += pack(sid, 0, FLAG_INITIAL if prev == 0 and recv < start else 0, seq, recv, src,
-                                lost_so_far[i])
+                                lost_so_far[i], *production(sid, hist_info_addr))
                     out += view
                 continue
             while True:
@@ -253,19 +278,21 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                         first[i] = False
                         if t - age < start:
                             flags |= FLAG_INITIAL
-                    out += pack(sid, status, flags, seq, t - age, src, lost)
+                    out += pack(sid, status, flags, seq, t - age, src, lost, *production(sid, info_addr))
                     out += view
                 if not event:
                     break
         if len(out) >= 65536 or ((out or pending) and t - last_send >= 20_000_000):
             # every value received up to t has now been read: the writer may write those
-            out += pack(WATERMARK_ID, 0, 0, 0, t, 0, 0)
+            out += pack(WATERMARK_ID, 0, 0, 0, t, 0, 0, -1, -1, 0)
             pending += out
             out.clear()
             _write_some(fd, pending)
             last_send = t
         if t - last_check >= 1_000_000_000:
             last_check = t
+            if ages is not None:
+                ages.follow(time.monotonic())  # a restarted ccommd's new view
             if not writer_alive():
                 return 1
             if len(pending) > 256 << 20 and not warned:

@@ -418,6 +418,10 @@ typedef struct ccomm_production_age {
   int64_t age_ns;    /**< since the producer wrote the value, as of this call; -1 when unknown */
   int64_t error_ns;  /**< |true age - age_ns| <= error_ns (the two clocks' bounds plus 1 us for reading
                           them); -1 when unknown: never an age presented as exact when it is not */
+  int64_t production_time_ns; /**< when the producer wrote the value, on the common time base: this
+                                   board's CLOCK_REALTIME in ns since the epoch (within +/- error_ns);
+                                   the DDS source timestamp and the recorder's publish time. -1 when
+                                   unknown. Added in 0.3 (growable: older callers do not get it) */
 } ccomm_production_age;
 /**
  * The production age of the value a read of signal `s` returned (`info`, as ccomm_read*
@@ -430,6 +434,9 @@ CCOMM_API int ccomm_view_production_age_sized(const ccomm_view* v, ccomm_signal 
                                               ccomm_production_age* out, size_t size);
 #define ccomm_view_production_age(v, s, info, out) \
   ccomm_view_production_age_sized((v), (s), (info), (out), sizeof(*(out)))
+/** "synced", "same_node", "never", "local_unsynced", "producer_unsynced", "no_summary"
+ *  (or "?"): a ccomm_production_age_code as tools print and record it. */
+CCOMM_API const char* ccomm_production_age_name(int code);
 
 /** Fills `out`; CCOMM_E_INVAL for a bad handle or node index, CCOMM_E_BUSY if the record
  *  was being rewritten throughout ~50 ms of waiting (ccommd stopped mid-rewrite). The view

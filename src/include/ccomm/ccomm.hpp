@@ -215,7 +215,7 @@ class SystemView : private detail::Owned<ccomm_view> {
   ccomm_production_age production_age(const Signal<T>& s, const Reading<T>& r) const {
     ccomm_production_age a{};
     a.code = CCOMM_PAGE_NO_SUMMARY;
-    a.age_ns = a.error_ns = -1;
+    a.age_ns = a.error_ns = a.production_time_ns = -1;
     if (ccomm_view_production_age(h_, s.id(), &r.info, &a) != 0) a.known = 0;
     return a;
   }

@@ -90,7 +90,7 @@ def message_encoder(desc: SignalInfo) -> Tuple[None, MessageEncoder]:
         prefix = _CDR_LE + body
 
     def encode(buf: bytes, off: int, status: int, flags: int, seq: int, recv: int, src: int, lost: int,
-               gap: int) -> bytes:
+               gap: int, prod: int, prod_err: int, code: int) -> bytes:  # times: the publish time
         return prefix + bytes(buf[off:off + n])
 
     return None, encode

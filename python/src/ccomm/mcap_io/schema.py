@@ -6,7 +6,8 @@ encoding "jsonschema": tools that know MCAP plot the fields without ccomm. A mes
 
     {"value": 1.5, "seq": 812, "source_time_ns": ..., "receive_time_ns": ...,
      "status": "fresh", "fresh": true, "safe_value": false,
-     "lost": 0, "gap": 0}
+     "lost": 0, "gap": 0, "initial": false,
+     "production_time_ns": ..., "production_error_ns": 2000, "age_code": "synced"}
 
 value           a number (bool: true/false), or an array for count > 1; NaN and
                 infinities are JSON null (JSON has no such numbers)
@@ -20,12 +21,20 @@ gap             values the recorder did not see between the previous message and
                 (a jump in seq); 0 in a complete recording
 initial         true for a state's value that was already there when the recording
                 started (it arrived before): logged at the start, its own times kept
+production_time_ns  when the producer wrote the value on the boards' common time base
+                (CLOCK_REALTIME ns since the epoch, as ptp4l disciplines it), within
+                +/- production_error_ns; null when unknown (age_code says why)
+production_error_ns the bound on that (0 for a value produced on the recording node);
+                null when unknown
+age_code        ccomm_production_age_code: "synced" (both clocks synced), "same_node"
+                (exact), or why the production time is unknown: "local_unsynced",
+                "producer_unsynced", "no_summary" (docs/design.md, "Time")
 
 Messages are in log-time order. The MCAP log time is the receive time (for an initial
-value, the recording's start) and the publish time the source time, both moved
-to the Unix epoch by the offset between CLOCK_REALTIME and CLOCK_MONOTONIC at the start
-of the recording (in the "ccomm" metadata record); the publish time is exact only when
-the producer shares the recorder's clock (one host).
+value, the recording's start), moved to the Unix epoch by the offset between
+CLOCK_REALTIME and CLOCK_MONOTONIC at the start of the recording (in the "ccomm" metadata
+record). The publish time is the production time when known, else the receive time (so
+it is never a producer's monotonic stamp read against another board's clock).
 """
 from __future__ import annotations
 
@@ -42,14 +51,19 @@ METADATA_NAME = "ccomm"
 FORMAT_VERSION = "1"
 
 # A captured value as the recorder hands it to the writer: signal id, status, flags, seq,
-# receive time, source time, lost; then value_bytes bytes of value.
-RECORD = struct.Struct("<HBBQqQQ")
+# receive time, source time, lost, production time (CLOCK_REALTIME, -1 unknown), its error
+# bound (-1 unknown), production age code (ccomm_production_age_code); then value_bytes
+# bytes of value.
+RECORD = struct.Struct("<HBBQqQQqqb")
 FLAG_SAFE_VALUE = 0x1
 # The signal's first value, received before the recording started: logged at the start.
 FLAG_INITIAL = 0x2
 # A record with this signal id (and no value bytes) is a watermark: the capture has read
 # every value that arrived up to its receive time, so the writer can write those in order.
 WATERMARK_ID = 0xFFFF
+# ccomm_production_age_code by value (ccomm_production_age_name; read once from libccomm
+# by the recorder, fixed here so the writer and the schema need no library).
+AGE_CODES = ("synced", "same_node", "never", "local_unsynced", "producer_unsynced", "no_summary")
 
 
 def schema_name(desc: SignalInfo) -> str:
@@ -79,6 +93,12 @@ def json_schema(desc: SignalInfo) -> bytes:
             "gap": dict(integer, description="values the recorder missed just before this one"),
             "initial": {"type": "boolean", "description": "already there when the recording started: "
                         "logged at the start, its own times kept"},
+            "production_time_ns": {"type": ["integer", "null"], "description":
+                                   "the write on the common time base (CLOCK_REALTIME); null: unknown"},
+            "production_error_ns": {"type": ["integer", "null"], "description":
+                                    "+/- bound of production_time_ns; null: unknown"},
+            "age_code": {"type": "string", "enum": list(AGE_CODES), "description":
+                         "synced, same_node: production time known; else why not"},
         },
         "required": ["value", "seq", "source_time_ns", "receive_time_ns", "status", "lost", "gap"],
     }
@@ -107,8 +127,9 @@ def _number_text(type_name: str) -> Callable[[object], str]:
     return str
 
 
-# encode(buffer, offset of the value, status, flags, seq, recv_ns, src_ns, lost, gap)
-MessageEncoder = Callable[[bytes, int, int, int, int, int, int, int, int], bytes]
+# encode(buffer, offset of the value, status, flags, seq, recv_ns, src_ns, lost, gap,
+#        production time ns (-1 unknown), its error ns, age code)
+MessageEncoder = Callable[[bytes, int, int, int, int, int, int, int, int, int, int, int], bytes]
 
 
 def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
@@ -119,12 +140,13 @@ def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
     floating = desc.type_name in ("float", "double")
     head = '{"value":'
     tail = ('"seq":%d,"source_time_ns":%d,"receive_time_ns":%d,"status":"%s",'
-            '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d,"initial":%s}')
+            '"fresh":%s,"safe_value":%s,"lost":%d,"gap":%d,"initial":%s,'
+            '"production_time_ns":%s,"production_error_ns":%s,"age_code":"%s"}')
     unpack_from = vs.unpack_from
     scalar = desc.count == 1
 
     def encode(buf: bytes, off: int, status: int, flags: int, seq: int, recv: int, src: int, lost: int,
-               gap: int) -> bytes:
+               gap: int, prod: int, prod_err: int, code: int) -> bytes:
         vals = unpack_from(buf, off)
         if scalar:
             text = number(vals[0])
@@ -137,6 +159,8 @@ def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
         return (head + text + "," + tail % (
             seq, src, recv, STATUS_NAMES[status] if status < 4 else "?",
             "true" if status == 0 else "false", "true" if flags & FLAG_SAFE_VALUE else "false",
-            lost, gap, "true" if flags & FLAG_INITIAL else "false")).encode()
+            lost, gap, "true" if flags & FLAG_INITIAL else "false",
+            prod if prod >= 0 else "null", prod_err if prod >= 0 else "null",
+            AGE_CODES[code] if 0 <= code < len(AGE_CODES) else "?")).encode()
 
     return vs, encode

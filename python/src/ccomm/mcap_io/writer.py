@@ -167,7 +167,7 @@ class RecordingWriter:
         pos, end, n = 0, len(buf), 0
         held, started = self.held, self.o.started_ns
         while pos + head <= end:
-            sid, status, flags, seq, recv, src, lost = unpack_from(buf, pos)
+            sid, status, flags, seq, recv, src, lost, prod, prod_err, code = unpack_from(buf, pos)
             if sid == WATERMARK_ID:  # every value stored by ccommd up to recv has been captured
                 self.watermark = recv + offset
                 self._write_held(self.watermark - self.hold_ns)
@@ -186,13 +186,15 @@ class RecordingWriter:
                 st.gaps += max(0, gap - (lost - st.last_lost))
             st.values += 1
             st.last_seq, st.last_lost = seq, lost
-            data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap)
+            data = encoders[sid](buf, pos + head, status, flags, seq, recv, src, lost, gap, prod, prod_err, code)
             # an initial value (received before the start) is logged at the start
             log_time = started if flags & FLAG_INITIAL else recv + offset
             if not flags & FLAG_INITIAL and log_time < self.watermark - self.hold_ns // 2:
                 # stored by ccommd well after its stamp: hold longer from now on
                 self.hold_ns = min(HOLD_MAX_NS, max(self.hold_ns, 2 * (self.watermark - log_time)))
-            heapq.heappush(held, (log_time, self.order, channel[sid], data, src + offset, seq & 0xFFFFFFFF))
+            # publish time: the production on the common time base, else the arrival here
+            publish_time = prod if prod >= 0 else recv + offset
+            heapq.heappush(held, (log_time, self.order, channel[sid], data, publish_time, seq & 0xFFFFFFFF))
             self.order += 1
             pos += head + size
             n += 1

@@ -6,9 +6,13 @@ Foxglove layout made for a recording works live too (plot `SIGNAL.value`):
 
     {"value": 1.5, "seq": 812, "source_time_ns": ..., "receive_time_ns": ...,
      "age_ns": 1200, "status": "fresh", "fresh": true, "safe_value": false,
-     "lost": 0, "gap": 0}
+     "lost": 0, "gap": 0, "production_time_ns": ..., "production_error_ns": 2000,
+     "age_code": "synced", "production_age_ns": 41200}
 
-Live only: `age_ns` (at the read), status "never" (nothing received yet; value 0, times
+Live only: `age_ns` (at the read, since the value reached this node), `production_age_ns`
+(at the read, since the producer wrote it: the end-to-end age on the boards' common time
+base, within +/- production_error_ns; null when unknown, age_code says why: then only
+the local age_ns is known), status "never" (nothing received yet; value 0, times
 null). `gap` counts the values this view did not see between two of its messages: a
 signal written faster than the sampling is sampled (`lost` is ccomm's loss counter).
 
@@ -23,7 +27,10 @@ from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
 
+from .. import _view
+from .._errors import CcommError
 from ..client import Client, Reading, Signal, SignalInfo, Status
+from ..mcap_io.schema import AGE_CODES
 
 _STATUS_NAMES = {Status.FRESH: "fresh", Status.STALE: "stale", Status.NEVER: "never"}
 
@@ -54,15 +61,23 @@ def json_schema(info: SignalInfo) -> Dict[str, Any]:
             "safe_value": {"type": "boolean", "description": "value is the configured safe value"},
             "lost": dict(integer, description="values known lost before this one (cumulative)"),
             "gap": dict(integer, description="values this view did not see just before this one"),
+            "production_time_ns": dict(nullable, description="the write on the common time base "
+                                       "(CLOCK_REALTIME); null: unknown"),
+            "production_error_ns": dict(nullable, description="+/- bound of the production time and age"),
+            "age_code": {"type": "string", "enum": list(AGE_CODES),
+                         "description": "synced, same_node: production age known; else why not (ages local)"},
+            "production_age_ns": dict(nullable, description="since the producer wrote the value, at the read"),
         },
         "required": ["value", "seq", "source_time_ns", "receive_time_ns", "age_ns", "status", "fresh",
-                     "safe_value", "lost", "gap"],
+                     "safe_value", "lost", "gap", "production_time_ns", "production_error_ns", "age_code",
+                     "production_age_ns"],
     }
 
 
-def message_of(reading: Reading, now_ns: int, gap: int = 0) -> Dict[str, Any]:
-    """The JSON message of one read (not EMPTY) made at CLOCK_MONOTONIC `now_ns`. NaN and
-    infinities become null: JSON has no spelling for them."""
+def message_of(reading: Reading, now_ns: int, gap: int = 0, production: Optional[Any] = None) -> Dict[str, Any]:
+    """The JSON message of one read (not EMPTY) made at CLOCK_MONOTONIC `now_ns`, with its
+    production age (`production`: a _native.ProductionAge for that read; None: unknown,
+    no_summary). NaN and infinities become null: JSON has no spelling for them."""
     value: Any = reading.value
     if isinstance(value, np.ndarray):
         value = [_finite(v) for v in value.tolist()]
@@ -74,7 +89,16 @@ def message_of(reading: Reading, now_ns: int, gap: int = 0) -> Dict[str, Any]:
             "receive_time_ns": None if reading.age_ns is None else now_ns - reading.age_ns,
             "age_ns": reading.age_ns, "status": _STATUS_NAMES[reading.status],
             "fresh": reading.status == Status.FRESH, "safe_value": reading.safe_value,
-            "lost": reading.lost, "gap": gap}
+            "lost": reading.lost, "gap": gap, **_production_fields(production)}
+
+
+def _production_fields(pa: Optional[Any]) -> Dict[str, Any]:
+    if pa is None or not pa.known:
+        return {"production_time_ns": None, "production_error_ns": None,
+                "age_code": AGE_CODES[pa.code] if pa is not None and 0 <= pa.code < len(AGE_CODES) else "no_summary",
+                "production_age_ns": None}
+    return {"production_time_ns": pa.production_time_ns, "production_error_ns": pa.error_ns,
+            "age_code": AGE_CODES[pa.code], "production_age_ns": pa.age_ns}
 
 
 def _finite(v: Any) -> Any:
@@ -106,8 +130,20 @@ class Sampler:
     _tracked: List[_Tracked] = field(default_factory=list)
     _now_ns: int = 0
 
+    _ages: Optional[_view.ProductionAges] = None
+    _followed: float = 0.0
+
     def __post_init__(self) -> None:
         self._tracked = [_Tracked(self.client.signal(n)) for n in self.names]
+        try:  # production ages need the system view (a ccommd older than it has none)
+            self._ages = _view.ProductionAges(self.client.handle)
+        except CcommError:  # then every age is local, and messages say no_summary
+            self._ages = None
+
+    def close(self) -> None:
+        if self._ages is not None:
+            self._ages.close()
+            self._ages = None
 
     @property
     def published(self) -> Dict[str, int]:
@@ -124,6 +160,9 @@ class Sampler:
     def poll(self, now: Optional[float] = None) -> int:
         """One pass over every signal; returns how many messages were published."""
         now = time.monotonic() if now is None else now
+        if self._ages is not None and now - self._followed >= 1.0:
+            self._followed = now
+            self._ages.follow(now)  # a restarted ccommd's new view
         self._now_ns = self.client.now()  # receive times: one clock reading per pass
         sent = 0
         for t in self._tracked:
@@ -149,4 +188,7 @@ class Sampler:
         t.gaps += gap
         t.last_seq, t.last_status, t.last_sent = r.seq, r.status, now
         t.published += 1
-        self.publish(t.signal.name, message_of(r, self._now_ns, gap))
+        pa = None
+        if self._ages is not None:
+            pa = self._ages.of(t.signal.info.id, r.seq, r.source_time_ns)
+        self.publish(t.signal.name, message_of(r, self._now_ns, gap, pa))

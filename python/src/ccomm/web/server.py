@@ -167,22 +167,25 @@ class LiveServer:
             try:
                 with Client(self.node) as client:
                     sampler = Sampler(client, [i.name for i in self.infos], self._publish, self.keepalive)
-                    base, base_changes, base_gaps = dict(self.published), dict(self.changes), dict(self.gaps)
-                    while not self.stop_event.is_set():
-                        started = time.monotonic()
-                        client.wait(timeout=0.1)
-                        sampler.poll()
-                        self._watch_daemon(client.daemon_alive)
-                        for name, n in sampler.published.items():
-                            self.published[name] = base[name] + n
-                        for name, n in sampler.changes.items():
-                            self.changes[name] = base_changes[name] + n
-                        for name, n in sampler.gaps.items():
-                            self.gaps[name] = base_gaps[name] + n
-                        self.ws.broadcast_time(time.time_ns())
-                        rest = min_period - (time.monotonic() - started)
-                        if rest > 0:
-                            self.stop_event.wait(rest)
+                    try:
+                        base, base_changes, base_gaps = dict(self.published), dict(self.changes), dict(self.gaps)
+                        while not self.stop_event.is_set():
+                            started = time.monotonic()
+                            client.wait(timeout=0.1)
+                            sampler.poll()
+                            self._watch_daemon(client.daemon_alive)
+                            for name, n in sampler.published.items():
+                                self.published[name] = base[name] + n
+                            for name, n in sampler.changes.items():
+                                self.changes[name] = base_changes[name] + n
+                            for name, n in sampler.gaps.items():
+                                self.gaps[name] = base_gaps[name] + n
+                            self.ws.broadcast_time(time.time_ns())
+                            rest = min_period - (time.monotonic() - started)
+                            if rest > 0:
+                                self.stop_event.wait(rest)
+                    finally:
+                        sampler.close()  # its view before the client
             except RetiredError:
                 print("ccomm-web: ccommd restarted with a new configuration; attaching again", flush=True)
             except CcommError as e:

@@ -46,6 +46,27 @@ function formatAge(ns) {
   return ms < 1000 ? ms.toFixed(1) + " ms" : (ms / 1000).toFixed(1) + " s";
 }
 
+function formatError(ns) {
+  if (ns < 1000) return ns + " ns";
+  if (ns < 1e6) return (ns / 1e3).toFixed(1) + " µs";
+  return formatAge(ns);
+}
+
+// The age column: the production age (since the producer wrote the value, on the boards'
+// common time base) with +/- its error bound when known; otherwise the local age (since
+// the value reached this node) marked "local", the reason in the tooltip.
+function ageCell(m) {
+  if (m.production_age_ns !== null && m.production_age_ns !== undefined)
+    return { text: formatAge(m.production_age_ns) + " ±" + formatError(m.production_error_ns), local: false,
+             title: "production age (" + m.age_code + "): since the producer wrote the value, within ±" +
+                    formatError(m.production_error_ns) };
+  if (m.age_ns === null || m.age_ns === undefined) return { text: "–", local: false, title: "" };
+  return { text: formatAge(m.age_ns) + " local", local: true,
+           title: "local age, since the value reached this node: the production age is unknown (" +
+                  (m.age_code || "no_summary") + ")" };
+}
+view.ageCell = ageCell;
+
 // ---- table ---------------------------------------------------------------------------
 
 function buildTable(cfg) {
@@ -82,7 +103,10 @@ function updateRow(row) {
   if (!m) return;
   tr.querySelector(".value").textContent = formatValue(m.value);
   tr.querySelector(".seq").textContent = String(m.seq);
-  tr.querySelector(".age").textContent = formatAge(m.age_ns);
+  const age = ageCell(m), ageTd = tr.querySelector(".age");
+  ageTd.textContent = age.text;
+  ageTd.title = age.title;
+  ageTd.classList.toggle("local", age.local);
   const lost = tr.querySelector(".lost");
   lost.textContent = String(m.lost);
   lost.classList.toggle("nonzero", m.lost > 0);

@@ -23,15 +23,8 @@
 #include <time.h>
 #include <unistd.h>
 
-static int64_t Ns(clockid_t c) {
-  struct timespec t;
-  clock_gettime(c, &t);
-  return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
-}
-static int Cmp(const void* a, const void* b) {
-  int64_t x = *(const int64_t*)a, y = *(const int64_t*)b;
-  return x < y ? -1 : x > y;
-}
+#include "txtime_common.h"
+
 
 int main(int argc, char** argv) {
   if (argc < 7) {

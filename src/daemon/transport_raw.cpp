@@ -32,14 +32,20 @@ struct RawState {
 
 RawState* State(Transport* t) { return static_cast<RawState*>(t->state); }
 
-int RawSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
+// Where a frame to `to` goes: this socket's interface and EtherType, the peer's MAC.
+struct sockaddr_ll AddressTo(const RawState& st, const PeerAddress& to) {
   struct sockaddr_ll sll;
   memset(&sll, 0, sizeof sll);
   sll.sll_family = AF_PACKET;
-  sll.sll_ifindex = State(t)->ifindex;
-  sll.sll_protocol = htons(State(t)->ethertype);
+  sll.sll_ifindex = st.ifindex;
+  sll.sll_protocol = htons(st.ethertype);
   sll.sll_halen = 6;
   memcpy(sll.sll_addr, to.mac, 6);
+  return sll;
+}
+
+int RawSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
+  struct sockaddr_ll sll = AddressTo(*State(t), to);
   if (t->txtime_asap_ns)  // send on the cycle: launch times on (send_cycle.h)
     return SendWithLaunch(State(t)->fd, &sll, sizeof sll, frame, len, TaiNs() + t->txtime_asap_ns);
   ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sll), sizeof sll);
@@ -120,13 +126,7 @@ void RawClose(Transport* t) {
 
 // --- send on the cycle (send_cycle.h, txtime_socket.h) ---
 int RawSendAt(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len, uint64_t launch_tai_ns) {
-  struct sockaddr_ll sll;
-  memset(&sll, 0, sizeof sll);
-  sll.sll_family = AF_PACKET;
-  sll.sll_ifindex = State(t)->ifindex;
-  sll.sll_protocol = htons(State(t)->ethertype);
-  sll.sll_halen = 6;
-  memcpy(sll.sll_addr, to.mac, 6);
+  struct sockaddr_ll sll = AddressTo(*State(t), to);
   return SendWithLaunch(State(t)->fd, &sll, sizeof sll, frame, len, launch_tai_ns);
 }
 void RawTxtimeSetup(Transport* t, TxtimeProbe* probe, std::string* detail) {

@@ -15,6 +15,7 @@
 
 #include "common/platform.h"
 #include "daemon/transport.h"
+#include "daemon/transport_udp_address.h"
 #include "daemon/txtime_socket.h"
 
 namespace ccomm {
@@ -42,11 +43,7 @@ struct UdpState {
 UdpState* State(Transport* t) { return static_cast<UdpState*>(t->state); }
 
 int UdpSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
-  struct sockaddr_in sin;
-  memset(&sin, 0, sizeof sin);
-  sin.sin_family = AF_INET;
-  sin.sin_addr.s_addr = to.ipv4;
-  sin.sin_port = to.port ? to.port : State(t)->port;
+  struct sockaddr_in sin = UdpAddressTo(to, State(t)->port);
   if (t->txtime_asap_ns)  // send on the cycle: launch times on (send_cycle.h)
     return SendWithLaunch(State(t)->fd, &sin, sizeof sin, frame, len, TaiNs() + t->txtime_asap_ns);
   ssize_t n = sendto(State(t)->fd, frame, len, 0, reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
@@ -177,11 +174,7 @@ void UdpClose(Transport* t) {
 
 // --- send on the cycle (send_cycle.h, txtime_socket.h) ---
 int UdpSendAt(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len, uint64_t launch_tai_ns) {
-  struct sockaddr_in sin;
-  memset(&sin, 0, sizeof sin);
-  sin.sin_family = AF_INET;
-  sin.sin_addr.s_addr = to.ipv4;
-  sin.sin_port = to.port ? to.port : State(t)->port;
+  struct sockaddr_in sin = UdpAddressTo(to, State(t)->port);
   return SendWithLaunch(State(t)->fd, &sin, sizeof sin, frame, len, launch_tai_ns);
 }
 // The qdiscs that count are those of interface= or, without it, of the interface with ip=.

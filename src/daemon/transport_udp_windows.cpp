@@ -8,6 +8,7 @@
 //   fail with WSAECONNRESET unless SIO_UDP_CONNRESET is off: it is turned off.
 // - A datagram larger than the buffer fails with WSAEMSGSIZE (Linux: MSG_TRUNC's length).
 // - Winsock counts no drops per socket: socket_drops says -ENOSYS.
+// - The default receive buffer is small (64 KiB): ccommd asks for 4 MiB.
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
@@ -22,9 +23,12 @@
 
 #include "common/platform.h"
 #include "daemon/transport.h"
+#include "daemon/transport_udp_address.h"
 
 namespace ccomm {
 namespace {
+
+constexpr int kReceiveBufferBytes = 4 << 20;
 
 struct UdpState {
   SOCKET sock = INVALID_SOCKET;
@@ -59,11 +63,7 @@ std::string WsaText(int wsa) {
 }
 
 int UdpSend(Transport* t, const PeerAddress& to, const uint8_t* frame, size_t len) {
-  struct sockaddr_in sin;
-  memset(&sin, 0, sizeof sin);
-  sin.sin_family = AF_INET;
-  sin.sin_addr.s_addr = to.ipv4;
-  sin.sin_port = to.port ? to.port : State(t)->port;
+  struct sockaddr_in sin = UdpAddressTo(to, State(t)->port);
   const int n = sendto(State(t)->sock, reinterpret_cast<const char*>(frame), static_cast<int>(len), 0,
                        reinterpret_cast<struct sockaddr*>(&sin), sizeof sin);
   return n == static_cast<int>(len) ? 0 : -ErrnoOf(WSAGetLastError());
@@ -158,6 +158,11 @@ int OpenUdpTransport(const NetworkConfig& net, const NodeConfig& self, int recv_
   WSAIoctl(st->sock, SIO_UDP_CONNRESET, &off, sizeof off, nullptr, 0, &got, nullptr, nullptr);
   BOOL one = TRUE;
   setsockopt(st->sock, SOL_SOCKET, SO_REUSEADDR, reinterpret_cast<const char*>(&one), sizeof one);
+  // Windows' default receive buffer (64 KiB: some 25 frames of 36 doubles) overflows when
+  // the receive thread is held up for 25 ms, which a desktop PC does: room for about a
+  // second at 1 kHz instead (best effort; the system may grant less).
+  const int rcvbuf = kReceiveBufferBytes;
+  setsockopt(st->sock, SOL_SOCKET, SO_RCVBUF, reinterpret_cast<const char*>(&rcvbuf), sizeof rcvbuf);
   struct sockaddr_in sin;
   memset(&sin, 0, sizeof sin);
   sin.sin_family = AF_INET;

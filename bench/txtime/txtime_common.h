@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: Apache-2.0
+// What the two launch-time programs share (txtime_spread.c, txtime_departures.c): a clock
+// in nanoseconds and the comparison their percentiles sort with.
+#pragma once
+
+#include <stdint.h>
+#include <time.h>
+
+static int64_t Ns(clockid_t c) {
+  struct timespec t;
+  clock_gettime(c, &t);
+  return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
+}
+static int Cmp(const void* a, const void* b) {
+  int64_t x = *(const int64_t*)a, y = *(const int64_t*)b;
+  return x < y ? -1 : x > y;
+}

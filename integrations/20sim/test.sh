@@ -7,6 +7,7 @@
 #   - the step order: a model with a derivative kick, states and a matrix, generated for
 #     Discrete, Euler, RungeKutta2 and RungeKutta4, sample by sample against a reference
 #     of 20-sim's documented order (test/step_order.py); the template language;
+#   - the documented function list against what the target defines (test/doc_functions.py);
 #   - the 4C component: generated from signals.xml, run by the 4C harness, same checks.
 # Usage: test.sh CCOMM_BIN_DIR [INTEGRATION_BIN_DIR]  (ccommd/ccomm, then the built tests)
 set -euo pipefail
@@ -157,6 +158,9 @@ else echo "FAIL matrix helpers"; fail=1; fi
 
 echo "== 20-sim C-code target: template language (%IF% with EQ/NEQ/NOT/AND/OR, undefined tokens)"
 if python3 "$here/test/tokensubst_check.py"; then :; else fail=1; fi
+
+echo "== 20-sim C-code target: the documented function list against xxfuncs.c / xxmatrix.c"
+if python3 "$here/test/doc_functions.py" --cc "${CC:-cc}"; then :; else fail=1; fi
 
 echo "== 20-sim C-code target: the generated project builds with its own CMakeLists.txt"
 python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \

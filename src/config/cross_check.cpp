@@ -128,6 +128,12 @@ void Parser::CrossCheck(SystemConfig* cfg) {
                         "'s send_cycle_us " + std::to_string(rt.send_cycle_us) + " (line " +
                         std::to_string(rt.send_cycle_line) + ")");
     }
+    // stale_by="production" learns whether the producer's clock is synced from its node
+    // summaries: without them every value would silently be judged by its arrival.
+    if (s.stale_by == StaleBy::kProduction && cfg->network.summary_ms == 0)
+      Err(s.line, "stale_by=\"production\" on signal " + Quote(s.name) +
+                      " needs node summaries (the producer's clock state travels in them), but "
+                      "<network summary_ms=\"0\"> turns them off");
   }
   CrossCheckClock(cfg);
 }

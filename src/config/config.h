@@ -52,6 +52,7 @@ struct RealtimeConfig {
   uint32_t send_lead_us = 0;     // wake this early (< send_cycle_us); 0 in the file = default
   bool launch_time = true;       // launch_time="auto": SO_TXTIME where the kernel can; "sleep": never
   int send_cycle_line = 0;       // line of the send_cycle_us attribute, for messages
+  int send_lead_line = 0;        // line of the send_lead_us attribute (0: the default)
 };
 
 struct NodeConfig {

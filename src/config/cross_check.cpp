@@ -31,6 +31,16 @@ void Parser::CrossCheck(SystemConfig* cfg) {
                         " (line " + std::to_string(m.line) + ")");
     }
   }
+  // Send on the cycle: the send thread waits up to the lead for a round's instant, and
+  // heartbeats wait with it; a lead of a heartbeat or more would let peers time it out.
+  for (const NodeConfig& n : cfg->nodes) {
+    const RealtimeConfig& rt = n.realtime;
+    if (rt.send_lead_line && uint64_t{rt.send_lead_us} >= uint64_t{cfg->network.heartbeat_ms} * 1000)
+      Err(rt.send_lead_line, "send_lead_us " + std::to_string(rt.send_lead_us) + " is not below heartbeat_ms " +
+                                 std::to_string(cfg->network.heartbeat_ms) +
+                                 ": the send thread waits up to the lead for each round, heartbeats too, "
+                                 "so peers would report node " + Quote(n.name) + " lost");
+  }
   std::string known = cfg->nodes.empty()       ? " (no nodes defined)"
                       : cfg->nodes.size() <= 8 ? " (nodes: " + Join(node_names, ", ") + ")"
                                                : "";
@@ -128,6 +138,12 @@ void Parser::CrossCheck(SystemConfig* cfg) {
                         "'s send_cycle_us " + std::to_string(rt.send_cycle_us) + " (line " +
                         std::to_string(rt.send_cycle_line) + ")");
     }
+    // stale_by="production" learns whether the producer's clock is synced from its node
+    // summaries: without them every value would silently be judged by its arrival.
+    if (s.stale_by == StaleBy::kProduction && cfg->network.summary_ms == 0)
+      Err(s.line, "stale_by=\"production\" on signal " + Quote(s.name) +
+                      " needs node summaries (the producer's clock state travels in them), but "
+                      "<network summary_ms=\"0\"> turns them off");
   }
   CrossCheckClock(cfg);
 }

@@ -427,7 +427,7 @@ void Parser::SendCycle(const Element& e, RealtimeConfig* rt) {
       else if (lead >= c)
         Err(a->line, "send_lead_us " + a->value + " is not below send_cycle_us " + std::to_string(c));
       else
-        rt->send_lead_us = lead;
+        rt->send_lead_us = lead, rt->send_lead_line = a->line;
     }
   }
   if (const AttrValue* a = e.Get("launch_time")) {

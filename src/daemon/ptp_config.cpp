@@ -10,6 +10,13 @@ std::string Ptp4lConfig(const SystemConfig& cfg, uint32_t node, std::string* err
     return {};
   }
   const NodeConfig& n = cfg.nodes[node];
+  // ptp4l runs PTP on a named port; without one its file has an empty "[]" section, which
+  // ptp4l refuses ("could not parse port name") only when the unit starts it.
+  if (n.interface.empty()) {
+    *error = cfg.path + ":" + std::to_string(n.line) + ": node '" + n.name +
+             "' has no interface=: ptp4l needs the interface to run PTP on (docs/config.md, <clock>)";
+    return {};
+  }
   // Grandmaster candidates in the order given: priority1 100, 101, ... (lower wins the
   // best master clock algorithm); every other node never becomes master.
   int rank = -1;

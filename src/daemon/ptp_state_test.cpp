@@ -165,6 +165,22 @@ TEST(Ptp4lConfig, EachNodeItsRoleFromOneFile) {
   EXPECT_NE(err.find("no <clock> section"), std::string::npos) << err;
 }
 
+// A UDP node may omit interface=; ptp4l cannot run without one, so say so, not "[]".
+TEST(Ptp4lConfig, NodeWithoutInterfaceIsAnError) {
+  const char* xml =
+      "<ccomm version=\"1\">\n"
+      "  <node name=\"a\" ip=\"127.0.0.1\" transport=\"udp\"/>\n"
+      "  <node name=\"b\" ip=\"127.0.0.2\" transport=\"udp\"/>\n"
+      "  <signal name=\"s\" type=\"double\" producer=\"a\" consumers=\"b\"/>\n"
+      "  <clock grandmaster=\"a\"/>\n"
+      "</ccomm>\n";
+  SystemConfig cfg;
+  std::string err;
+  ASSERT_TRUE(ParseConfig(xml, "signals.xml", &cfg, &err)) << err;
+  EXPECT_EQ(Ptp4lConfig(cfg, 1, &err), "");
+  EXPECT_NE(err.find("signals.xml:3: node 'b' has no interface="), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace ptp
 }  // namespace ccomm

@@ -397,7 +397,13 @@ void SendPath::RunTx() {
       if (due_ns_[id] - lead < next_deadline) next_deadline = due_ns_[id] - lead;
     }
     if (!large_pending_.empty()) SendLargeValues(now);
-    if (on_cycle && cycle_instant != UINT64_MAX) CycleRound(cycle_instant);  // send on the cycle
+    // send on the cycle: only a round with frames to send waits for its instant and counts
+    // (periodic signals never written yet leave nothing to send).
+    if (on_cycle && cycle_instant != UINT64_MAX) {
+      bool frames = false;
+      for (uint32_t p : senders_) frames = frames || peers_tx_[p].open;
+      if (frames) CycleRound(cycle_instant);
+    }
     for (uint32_t p : senders_) {
       PeerTx& pt = peers_tx_[p];
       if (pt.open) {

@@ -412,20 +412,15 @@ void Parser::SendCycle(const Element& e, RealtimeConfig* rt) {
     return;
   }
   rt->send_cycle_us = c;
-  if (Unsigned(e, "send_phase_us", 0, kMaxSendCycleUs, &rt->send_phase_us) && rt->send_phase_us >= c) {
-    Err(e.Get("send_phase_us")->line, "send_phase_us " + std::to_string(rt->send_phase_us) +
-                                          " is not below send_cycle_us " + std::to_string(c));
-    rt->send_phase_us = 0;
-  }
+  // Phase and lead lie within the cycle: their range in the errors is the cycle's.
+  if (!Unsigned(e, "send_phase_us", 0, c - 1, &rt->send_phase_us)) rt->send_phase_us = 0;
   rt->send_lead_us = std::min(kDefaultSendLeadUs, c / 2);
   if (const AttrValue* a = e.Get("send_lead_us")) {
     uint32_t lead = 0;
-    if (Unsigned(e, "send_lead_us", 0, kMaxSendCycleUs, &lead)) {
+    if (Unsigned(e, "send_lead_us", 0, c - 1, &lead)) {
       if (lead < kMinSendLeadUs)
         Err(a->line, "send_lead_us " + a->value + " is too small (at least " + std::to_string(kMinSendLeadUs) +
                          " us: the send thread builds the frames in it)");
-      else if (lead >= c)
-        Err(a->line, "send_lead_us " + a->value + " is not below send_cycle_us " + std::to_string(c));
       else
         rt->send_lead_us = lead, rt->send_lead_line = a->line;
     }

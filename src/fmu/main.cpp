@@ -4,10 +4,13 @@
 // One process per FMU: a crash inside the FMU ends this process only; its outputs then
 // turn stale for their consumers and ccommd and other clients go on.
 #include <getopt.h>
+#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -85,6 +88,9 @@ void InstallHandlers() {
   for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaction(s, &st, nullptr);
 }
 
+// The period (--period or the FMU's stepSize): 1 us to 1 h, so that it fits the cycle arithmetic.
+constexpr double kMinPeriodNs = 1e3, kMaxPeriodNs = 3600e9;
+
 bool ParsePeriod(const char* s, int64_t* ns) {
   char* end = nullptr;
   double v = std::strtod(s, &end);
@@ -93,9 +99,23 @@ bool ParsePeriod(const char* s, int64_t* ns) {
   else if (std::strcmp(end, "us") == 0) scale = 1e3;
   else if (std::strcmp(end, "s") == 0) scale = 1e9;
   else if (std::strcmp(end, "ns") == 0) scale = 1;
-  if (scale == 0 || !(v > 0)) return false;
+  if (scale == 0 || !(v * scale >= kMinPeriodNs && v * scale <= kMaxPeriodNs)) return false;
   *ns = std::llround(v * scale);
-  return *ns >= 1000;
+  return true;
+}
+
+// A whole non-negative decimal number for --cycles, --priority, --cpu: no silent 0 for "abc".
+bool ParseCount(const char* option, const char* s, uint64_t max, uint64_t* out) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(s, &end, 10);
+  if (*s < '0' || *s > '9' || *end != '\0' || errno != 0 || v > max) {
+    std::fprintf(stderr, "ccomm-fmu: %s %s: expected a whole number from 0 to %llu\n", option, s,
+                 static_cast<unsigned long long>(max));
+    return false;
+  }
+  *out = v;
+  return true;
 }
 
 // Runs xmllint against the standard's schema (FMPy ships them); false with its output.
@@ -150,22 +170,32 @@ int Main(int argc, char** argv) {
       {nullptr, 0, nullptr, 0}};
   optind = 3;
   int ch;
+  uint64_t number = 0;
   while ((ch = getopt_long(argc, argv, "n:p:m:", kLong, nullptr)) != -1) {
     switch (ch) {
       case 'n': opt.node = optarg; break;
       case 'p':
         if (!ParsePeriod(optarg, &period_ns)) {
-          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time >= 1us like 1ms, 500us, 0.002s\n", optarg);
+          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time from 1us to 3600s like 1ms, 500us, 0.002s\n", optarg);
           return 1;
         }
         break;
       case 'm': map_path = optarg; break;
       case kIgnoreStep: ignore_default_step = true; break;
-      case kCycles: opt.cycles = std::strtoull(optarg, nullptr, 10); break;
+      case kCycles:
+        if (!ParseCount("--cycles", optarg, UINT64_MAX, &number)) return 1;
+        opt.cycles = number;
+        break;
       case kRecord: opt.record_path = optarg; break;
-      case kPriority: opt.priority = std::atoi(optarg); break;
+      case kPriority:
+        if (!ParseCount("--priority", optarg, 99, &number)) return 1;
+        opt.priority = static_cast<int>(number);
+        break;
       case kNoRt: opt.realtime = false; break;
-      case kCpu: opt.cpu = std::atoi(optarg); break;
+      case kCpu:
+        if (!ParseCount("--cpu", optarg, CPU_SETSIZE - 1, &number)) return 1;
+        opt.cpu = static_cast<int>(number);
+        break;
       case kSchema: schema_dir = optarg; break;
       case kFmuLog: opt.fmu_logging = true; break;
       case kMeasure: opt.measure = true; break;
@@ -198,7 +228,14 @@ int Main(int argc, char** argv) {
     return 1;
   }
   // The period and the model's step: never silently run the model at another speed.
-  const int64_t default_step_ns = std::llround(md.default_step * 1e9);
+  if (md.default_step != 0 && !(md.default_step * 1e9 >= kMinPeriodNs && md.default_step * 1e9 <= kMaxPeriodNs) &&
+      !(period_ns != 0 && ignore_default_step)) {
+    std::fprintf(stderr, "ccomm-fmu: the FMU's DefaultExperiment stepSize %g s is outside 1 us to 3600 s: give "
+                 "--period and --ignore-default-step to run it anyway\n", md.default_step);
+    return 1;
+  }
+  const int64_t default_step_ns =
+      md.default_step * 1e9 <= kMaxPeriodNs ? std::llround(md.default_step * 1e9) : 0;
   if (period_ns == 0) {
     if (default_step_ns == 0) {
       std::fprintf(stderr, "ccomm-fmu: %s has no DefaultExperiment stepSize: give --period\n", fmu_path.c_str());

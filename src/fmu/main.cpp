@@ -29,7 +29,7 @@ namespace {
 const char kUsage[] =
     "Usage: ccomm-fmu run FMU [OPTIONS]     run FMU (a .fmu file or an unpacked directory)\n"
     "       ccomm-fmu check FMU [OPTIONS]   validate it and its mapping against the signals, then exit\n"
-    "       ccomm-fmu build FMU [--cc CC] [--out FILE]   compile a source FMU for this board\n"
+    "       ccomm-fmu build FMU [--cc CC] [--fmi-include DIR] [--out FILE]   compile a source FMU\n"
     "  -n, --node NAME        node to attach to (default $CCOMM_NODE / hostname)\n"
     "  -p, --period TIME      task period (1ms, 500us, 0.002s); default the FMU's DefaultExperiment\n"
     "                         stepSize. Each cycle advances the model by exactly one period.\n"
@@ -104,14 +104,14 @@ bool ParsePeriod(const char* s, int64_t* ns) {
   return true;
 }
 
-// A whole non-negative decimal number for --cycles, --priority, --cpu: no silent 0 for "abc".
-bool ParseCount(const char* option, const char* s, uint64_t max, uint64_t* out) {
+// A whole decimal number in [min, max] for --cycles, --priority, --cpu: no silent 0 for "abc".
+bool ParseCount(const char* option, const char* s, uint64_t min, uint64_t max, uint64_t* out) {
   char* end = nullptr;
   errno = 0;
   const unsigned long long v = std::strtoull(s, &end, 10);
-  if (*s < '0' || *s > '9' || *end != '\0' || errno != 0 || v > max) {
-    std::fprintf(stderr, "ccomm-fmu: %s %s: expected a whole number from 0 to %llu\n", option, s,
-                 static_cast<unsigned long long>(max));
+  if (*s < '0' || *s > '9' || *end != '\0' || errno != 0 || v < min || v > max) {
+    std::fprintf(stderr, "ccomm-fmu: %s %s: expected a whole number from %llu to %llu\n", option, s,
+                 static_cast<unsigned long long>(min), static_cast<unsigned long long>(max));
     return false;
   }
   *out = v;
@@ -147,10 +147,13 @@ bool ValidateSchema(const std::string& schema_dir, int major, const std::string&
 }
 
 int Main(int argc, char** argv) {
-  if (argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0 &&
-                   std::strcmp(argv[1], "build") != 0)) {
-    std::fputs(kUsage, argc >= 2 && std::strcmp(argv[1], "--help") == 0 ? stdout : stderr);
-    return argc >= 2 && std::strcmp(argv[1], "--help") == 0 ? 0 : 1;
+  // --help or -h anywhere (also "run --help") asks for the usage, not for an FMU of that name.
+  bool help = false;
+  for (int i = 1; i < argc; ++i) help = help || std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0;
+  if (help || argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0 &&
+                           std::strcmp(argv[1], "build") != 0)) {
+    std::fputs(kUsage, help ? stdout : stderr);
+    return help ? 0 : 1;
   }
   const std::string command = argv[1];
   const std::string fmu_path = argv[2];
@@ -183,17 +186,17 @@ int Main(int argc, char** argv) {
       case 'm': map_path = optarg; break;
       case kIgnoreStep: ignore_default_step = true; break;
       case kCycles:
-        if (!ParseCount("--cycles", optarg, UINT64_MAX, &number)) return 1;
+        if (!ParseCount("--cycles", optarg, 0, UINT64_MAX, &number)) return 1;
         opt.cycles = number;
         break;
       case kRecord: opt.record_path = optarg; break;
       case kPriority:
-        if (!ParseCount("--priority", optarg, 99, &number)) return 1;
+        if (!ParseCount("--priority", optarg, 1, 99, &number)) return 1;
         opt.priority = static_cast<int>(number);
         break;
       case kNoRt: opt.realtime = false; break;
       case kCpu:
-        if (!ParseCount("--cpu", optarg, CPU_SETSIZE - 1, &number)) return 1;
+        if (!ParseCount("--cpu", optarg, 0, CPU_SETSIZE - 1, &number)) return 1;
         opt.cpu = static_cast<int>(number);
         break;
       case kSchema: schema_dir = optarg; break;

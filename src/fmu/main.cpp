@@ -280,6 +280,14 @@ int Main(int argc, char** argv) {
   }
   runner.PrintBindings(stderr);
   if (command == "check") {
+    // "Everything up to the first cycle": also instantiate and initialize (a licence check,
+    // a missing resource or a bad instantiationToken fail here, not only in run).
+    if (!binary.Instantiate(md.model_name, opt.fmu_logging, &error) || !binary.Initialize(&error)) {
+      std::fprintf(stderr, "ccomm-fmu: %s: %s\n", md.model_name.c_str(), error.c_str());
+      binary.Finish(kFmi3Error);
+      return 1;
+    }
+    binary.Finish(kFmi3OK);
     std::printf("ccomm-fmu: %s (FMI %d.0, %s) maps onto node %s: ok\n", fmu_path.c_str(), md.fmi_major,
                 md.model_name.c_str(), runner.node_name());
     return 0;

@@ -187,17 +187,17 @@ void Runner::PrintBindings(FILE* out) const {
 }
 
 void Runner::SetUpRealtime() {
-  if (!opt_.realtime) return;
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
-                 std::strerror(errno));
-  if (opt_.cpu >= 0) {
+  if (opt_.cpu >= 0) {  // also with --no-rt: --cpu is an option of its own
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(opt_.cpu, &set);
     if (sched_setaffinity(0, sizeof set, &set) != 0)
       std::fprintf(stderr, "ccomm-fmu: warning: cannot pin to CPU %d (%s)\n", opt_.cpu, std::strerror(errno));
   }
+  if (!opt_.realtime) return;
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
+                 std::strerror(errno));
   sched_param sp{};
   sp.sched_priority = opt_.priority;
   if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)

@@ -179,7 +179,8 @@ int Main(int argc, char** argv) {
       case 'n': opt.node = optarg; break;
       case 'p':
         if (!ParsePeriod(optarg, &period_ns)) {
-          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time from 1us to 3600s like 1ms, 500us, 0.002s\n", optarg);
+          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time from 1us to 3600s like 1ms, 500us, 0.002s\n",
+                       optarg);
           return 1;
         }
         break;

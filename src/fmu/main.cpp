@@ -4,10 +4,13 @@
 // One process per FMU: a crash inside the FMU ends this process only; its outputs then
 // turn stale for their consumers and ccommd and other clients go on.
 #include <getopt.h>
+#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -26,7 +29,7 @@ namespace {
 const char kUsage[] =
     "Usage: ccomm-fmu run FMU [OPTIONS]     run FMU (a .fmu file or an unpacked directory)\n"
     "       ccomm-fmu check FMU [OPTIONS]   validate it and its mapping against the signals, then exit\n"
-    "       ccomm-fmu build FMU [--cc CC] [--out FILE]   compile a source FMU for this board\n"
+    "       ccomm-fmu build FMU [--cc CC] [--fmi-include DIR] [--out FILE]   compile a source FMU\n"
     "  -n, --node NAME        node to attach to (default $CCOMM_NODE / hostname)\n"
     "  -p, --period TIME      task period (1ms, 500us, 0.002s); default the FMU's DefaultExperiment\n"
     "                         stepSize. Each cycle advances the model by exactly one period.\n"
@@ -85,6 +88,9 @@ void InstallHandlers() {
   for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaction(s, &st, nullptr);
 }
 
+// The period (--period or the FMU's stepSize): 1 us to 1 h, so that it fits the cycle arithmetic.
+constexpr double kMinPeriodNs = 1e3, kMaxPeriodNs = 3600e9;
+
 bool ParsePeriod(const char* s, int64_t* ns) {
   char* end = nullptr;
   double v = std::strtod(s, &end);
@@ -93,9 +99,23 @@ bool ParsePeriod(const char* s, int64_t* ns) {
   else if (std::strcmp(end, "us") == 0) scale = 1e3;
   else if (std::strcmp(end, "s") == 0) scale = 1e9;
   else if (std::strcmp(end, "ns") == 0) scale = 1;
-  if (scale == 0 || !(v > 0)) return false;
+  if (scale == 0 || !(v * scale >= kMinPeriodNs && v * scale <= kMaxPeriodNs)) return false;
   *ns = std::llround(v * scale);
-  return *ns >= 1000;
+  return true;
+}
+
+// A whole decimal number in [min, max] for --cycles, --priority, --cpu: no silent 0 for "abc".
+bool ParseCount(const char* option, const char* s, uint64_t min, uint64_t max, uint64_t* out) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(s, &end, 10);
+  if (*s < '0' || *s > '9' || *end != '\0' || errno != 0 || v < min || v > max) {
+    std::fprintf(stderr, "ccomm-fmu: %s %s: expected a whole number from %llu to %llu\n", option, s,
+                 static_cast<unsigned long long>(min), static_cast<unsigned long long>(max));
+    return false;
+  }
+  *out = v;
+  return true;
 }
 
 // Runs xmllint against the standard's schema (FMPy ships them); false with its output.
@@ -127,10 +147,13 @@ bool ValidateSchema(const std::string& schema_dir, int major, const std::string&
 }
 
 int Main(int argc, char** argv) {
-  if (argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0 &&
-                   std::strcmp(argv[1], "build") != 0)) {
-    std::fputs(kUsage, argc >= 2 && std::strcmp(argv[1], "--help") == 0 ? stdout : stderr);
-    return argc >= 2 && std::strcmp(argv[1], "--help") == 0 ? 0 : 1;
+  // --help or -h anywhere (also "run --help") asks for the usage, not for an FMU of that name.
+  bool help = false;
+  for (int i = 1; i < argc; ++i) help = help || std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0;
+  if (help || argc < 3 || (std::strcmp(argv[1], "run") != 0 && std::strcmp(argv[1], "check") != 0 &&
+                           std::strcmp(argv[1], "build") != 0)) {
+    std::fputs(kUsage, help ? stdout : stderr);
+    return help ? 0 : 1;
   }
   const std::string command = argv[1];
   const std::string fmu_path = argv[2];
@@ -150,22 +173,33 @@ int Main(int argc, char** argv) {
       {nullptr, 0, nullptr, 0}};
   optind = 3;
   int ch;
+  uint64_t number = 0;
   while ((ch = getopt_long(argc, argv, "n:p:m:", kLong, nullptr)) != -1) {
     switch (ch) {
       case 'n': opt.node = optarg; break;
       case 'p':
         if (!ParsePeriod(optarg, &period_ns)) {
-          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time >= 1us like 1ms, 500us, 0.002s\n", optarg);
+          std::fprintf(stderr, "ccomm-fmu: --period %s: expected a time from 1us to 3600s like 1ms, 500us, 0.002s\n",
+                       optarg);
           return 1;
         }
         break;
       case 'm': map_path = optarg; break;
       case kIgnoreStep: ignore_default_step = true; break;
-      case kCycles: opt.cycles = std::strtoull(optarg, nullptr, 10); break;
+      case kCycles:
+        if (!ParseCount("--cycles", optarg, 0, UINT64_MAX, &number)) return 1;
+        opt.cycles = number;
+        break;
       case kRecord: opt.record_path = optarg; break;
-      case kPriority: opt.priority = std::atoi(optarg); break;
+      case kPriority:
+        if (!ParseCount("--priority", optarg, 1, 99, &number)) return 1;
+        opt.priority = static_cast<int>(number);
+        break;
       case kNoRt: opt.realtime = false; break;
-      case kCpu: opt.cpu = std::atoi(optarg); break;
+      case kCpu:
+        if (!ParseCount("--cpu", optarg, 0, CPU_SETSIZE - 1, &number)) return 1;
+        opt.cpu = static_cast<int>(number);
+        break;
       case kSchema: schema_dir = optarg; break;
       case kFmuLog: opt.fmu_logging = true; break;
       case kMeasure: opt.measure = true; break;
@@ -198,7 +232,14 @@ int Main(int argc, char** argv) {
     return 1;
   }
   // The period and the model's step: never silently run the model at another speed.
-  const int64_t default_step_ns = std::llround(md.default_step * 1e9);
+  if (md.default_step != 0 && !(md.default_step * 1e9 >= kMinPeriodNs && md.default_step * 1e9 <= kMaxPeriodNs) &&
+      !(period_ns != 0 && ignore_default_step)) {
+    std::fprintf(stderr, "ccomm-fmu: the FMU's DefaultExperiment stepSize %g s is outside 1 us to 3600 s: give "
+                 "--period and --ignore-default-step to run it anyway\n", md.default_step);
+    return 1;
+  }
+  const int64_t default_step_ns =
+      md.default_step * 1e9 <= kMaxPeriodNs ? std::llround(md.default_step * 1e9) : 0;
   if (period_ns == 0) {
     if (default_step_ns == 0) {
       std::fprintf(stderr, "ccomm-fmu: %s has no DefaultExperiment stepSize: give --period\n", fmu_path.c_str());
@@ -240,6 +281,14 @@ int Main(int argc, char** argv) {
   }
   runner.PrintBindings(stderr);
   if (command == "check") {
+    // "Everything up to the first cycle": also instantiate and initialize (a licence check,
+    // a missing resource or a bad instantiationToken fail here, not only in run).
+    if (!binary.Instantiate(md.model_name, opt.fmu_logging, &error) || !binary.Initialize(&error)) {
+      std::fprintf(stderr, "ccomm-fmu: %s: %s\n", md.model_name.c_str(), error.c_str());
+      binary.Finish(kFmi3Error);
+      return 1;
+    }
+    binary.Finish(kFmi3OK);
     std::printf("ccomm-fmu: %s (FMI %d.0, %s) maps onto node %s: ok\n", fmu_path.c_str(), md.fmi_major,
                 md.model_name.c_str(), runner.node_name());
     return 0;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "model_description.h"
 
+#include <cmath>
 #include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
@@ -135,8 +136,9 @@ bool Parser::Run(Node* root, ModelDescription* md) {
   const char* net = Attr(cs, "needsExecutionTool");
   md->needs_execution_tool = net != nullptr && std::strcmp(net, "true") == 0;
   const char* fixed = Attr(cs, "fixedInternalStepSize");
-  if (fixed != nullptr && !ParseDouble(fixed, &md->fixed_internal_step))
-    return Fail(fixed, "fixedInternalStepSize is not a number");
+  if (fixed != nullptr && (!ParseDouble(fixed, &md->fixed_internal_step) || !(md->fixed_internal_step > 0) ||
+                           !std::isfinite(md->fixed_internal_step)))
+    return Fail(fixed, "fixedInternalStepSize is not a positive number");
   if (md->fmi_major == 2) {
     if (Node* sf = cs->first_node("SourceFiles"))
       for (Node* f = sf->first_node("File"); f != nullptr; f = f->next_sibling("File")) {
@@ -147,7 +149,8 @@ bool Parser::Run(Node* root, ModelDescription* md) {
   }
   if (Node* de = root->first_node("DefaultExperiment")) {
     const char* step = Attr(de, "stepSize");
-    if (step != nullptr && (!ParseDouble(step, &md->default_step) || md->default_step <= 0))
+    if (step != nullptr && (!ParseDouble(step, &md->default_step) || !(md->default_step > 0) ||
+                             !std::isfinite(md->default_step)))
       return Fail(step, "DefaultExperiment stepSize is not a positive number");
   }
   Node* list = root->first_node("ModelVariables");

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <new>
 
 extern char** environ;
 
@@ -186,17 +187,17 @@ void Runner::PrintBindings(FILE* out) const {
 }
 
 void Runner::SetUpRealtime() {
-  if (!opt_.realtime) return;
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
-                 std::strerror(errno));
-  if (opt_.cpu >= 0) {
+  if (opt_.cpu >= 0) {  // also with --no-rt: --cpu is an option of its own
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(opt_.cpu, &set);
     if (sched_setaffinity(0, sizeof set, &set) != 0)
       std::fprintf(stderr, "ccomm-fmu: warning: cannot pin to CPU %d (%s)\n", opt_.cpu, std::strerror(errno));
   }
+  if (!opt_.realtime) return;
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
+                 std::strerror(errno));
   sched_param sp{};
   sp.sched_priority = opt_.priority;
   if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
@@ -218,6 +219,13 @@ int Runner::Fail(int status, const char* what) {
   return 3;
 }
 
+int Runner::Retired() {
+  std::fputs("ccomm-fmu: ccommd replaced the segment (new configuration): stopping; restart the task\n", stderr);
+  binary_.Finish(kFmi3OK);
+  WriteRecord();
+  return 75;
+}
+
 double Runner::ElementAsDouble(const Binding& b, uint32_t i) {
   const uint8_t* p = b.value.data();
   switch (b.var->type) {
@@ -232,6 +240,21 @@ double Runner::ElementAsDouble(const Binding& b, uint32_t i) {
 
 int Runner::Run(volatile sig_atomic_t* stop) {
   std::string error;
+  const uint32_t columns = 3 + record_columns_ + (opt_.measure ? 2 : 0);
+  if (!opt_.record_path.empty()) {  // preallocated before the loop; refused here rather than lost at exit
+    record_file_ = std::fopen(opt_.record_path.c_str(), "w");
+    if (record_file_ == nullptr) {
+      std::fprintf(stderr, "ccomm-fmu: --record %s: %s\n", opt_.record_path.c_str(), std::strerror(errno));
+      return 1;
+    }
+    if (opt_.cycles <= SIZE_MAX / sizeof(double) / columns)
+      record_.reset(new (std::nothrow) double[opt_.cycles * columns]());
+    if (!record_) {
+      std::fprintf(stderr, "ccomm-fmu: --record: cannot hold %" PRIu64 " cycles of %u values in memory: give fewer "
+                   "--cycles\n", static_cast<uint64_t>(opt_.cycles), columns);
+      return 1;
+    }
+  }
   if (!binary_.Instantiate(md_.model_name, opt_.fmu_logging, &error) || !binary_.Initialize(&error)) {
     std::fprintf(stderr, "ccomm-fmu: %s: %s\n", md_.model_name.c_str(), error.c_str());
     binary_.Finish(kFmi3Error);
@@ -242,8 +265,6 @@ int Runner::Run(volatile sig_atomic_t* stop) {
   for (Binding& b : bindings_)
     if (b.kind == Kind::kInput || b.kind == Kind::kParameter)
       binary_.Get(b.var->type, b.var->value_reference, b.var->count, b.value.data());
-  const uint32_t columns = 3 + record_columns_ + (opt_.measure ? 2 : 0);
-  if (!opt_.record_path.empty()) record_.assign(opt_.cycles * columns, 0.0);  // preallocated before the loop
   SetUpRealtime();
   std::fprintf(stderr, "ccomm-fmu: running %s (FMI %d.0) every %g ms on node %s\n", md_.model_name.c_str(),
                binary_.fmi_major(), opt_.period_ns * 1e-6, ccomm_node_name(client_));
@@ -268,13 +289,10 @@ int Runner::Run(volatile sig_atomic_t* stop) {
       if (b.kind == Kind::kOutput) continue;
       ccomm_info info;
       int rc = ccomm_read(client_, b.signal, b.incoming.data(), b.bytes, &info);
-      if (rc == CCOMM_E_RETIRED) {
-        std::fputs("ccomm-fmu: ccommd replaced the segment (new configuration): stopping; restart the task\n", stderr);
-        binary_.Finish(kFmi3OK);
-        return 75;
-      }
+      if (rc == CCOMM_E_RETIRED) return Retired();
       if (rc < 0) { ++read_errors_; continue; }
       if (rc == CCOMM_STALE) ++stale_reads_;
+      if (rc == CCOMM_NEVER) ++never_reads_;
       int set = 0;
       if (b.kind == Kind::kFreshness) {
         uint8_t fresh = rc == CCOMM_FRESH;
@@ -302,9 +320,13 @@ int Runner::Run(volatile sig_atomic_t* stop) {
       if (b.kind != Kind::kOutput) continue;
       int g = binary_.Get(b.var->type, b.var->value_reference, b.var->count, b.value.data());
       if (g != 0) return Fail(g, (std::string("refused to give output ") + b.var->name).c_str());
-      if (ccomm_write(client_, b.signal, b.value.data(), b.bytes) != 0) ++write_errors_;
+      const int w = ccomm_write(client_, b.signal, b.value.data(), b.bytes);
+      if (w == CCOMM_E_RETIRED) return Retired();  // an FMU with outputs only learns it here
+      if (w != 0) ++write_errors_;
     }
-    if (ccomm_flush(client_) != 0) ++write_errors_;  // the outputs leave in one frame
+    const int f = ccomm_flush(client_);  // the outputs leave in one frame
+    if (f == CCOMM_E_RETIRED) return Retired();
+    if (f != 0) ++write_errors_;
     if (opt_.measure) {
       const int64_t end = Now();
       max_step_ = std::max(max_step_, step_end - step_start);
@@ -312,7 +334,7 @@ int Runner::Run(volatile sig_atomic_t* stop) {
       max_cycle_ = std::max(max_cycle_, end - now);
       sum_cycle_ += end - now;
     }
-    if (!record_.empty()) {
+    if (record_) {
       double* row = &record_[cycle_ * columns];
       *row++ = static_cast<double>(cycle_);
       *row++ = t;
@@ -342,8 +364,9 @@ void Runner::Report(FILE* out) const {
   const uint64_t n = cycle_ > 0 ? cycle_ : 1;
   std::fprintf(out, "ccomm-fmu: %" PRIu64 " cycles, %" PRIu64 " overruns (missed releases; the model lags real "
                "time by as many periods), lateness mean %.1f us max %.1f us, %" PRIu64 " stale reads, %" PRIu64
-               " read errors, %" PRIu64 " write errors\n", static_cast<uint64_t>(cycle_), overruns_,
-               sum_lateness_ / 1e3 / n, max_lateness_ / 1e3, stale_reads_, read_errors_, write_errors_);
+               " reads of signals that never had a value, %" PRIu64 " read errors, %" PRIu64 " write errors\n",
+               static_cast<uint64_t>(cycle_), overruns_, sum_lateness_ / 1e3 / n, max_lateness_ / 1e3, stale_reads_,
+               never_reads_, read_errors_, write_errors_);
   if (opt_.measure)
     std::fprintf(out, "ccomm-fmu: doStep mean %.2f us max %.2f us; whole cycle mean %.2f us max %.2f us; "
                  "ccomm-fmu's own cost per cycle %.2f us\n", sum_step_ / 1e3 / n, max_step_ / 1e3,
@@ -351,12 +374,8 @@ void Runner::Report(FILE* out) const {
 }
 
 void Runner::WriteRecord() const {
-  if (opt_.record_path.empty()) return;
-  FILE* f = std::fopen(opt_.record_path.c_str(), "w");
-  if (f == nullptr) {
-    std::fprintf(stderr, "ccomm-fmu: cannot write %s: %s\n", opt_.record_path.c_str(), std::strerror(errno));
-    return;
-  }
+  FILE* f = record_file_;  // opened at start
+  if (f == nullptr) return;
   std::fputs("cycle,time,lateness_ns", f);
   for (const Binding& b : bindings_) {
     const uint32_t n = b.kind == Kind::kFreshness ? 1 : b.var->count;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,7 @@ class Runner {
   };
   void SetUpRealtime();
   int Fail(int status, const char* what);
+  int Retired();  // ccommd replaced the segment: exit status 75
   void Report(FILE* out) const;
   void WriteRecord() const;
   static double ElementAsDouble(const Binding& b, uint32_t i);
@@ -82,10 +84,11 @@ class Runner {
   ccomm_client* client_ = nullptr;
   std::vector<Binding> bindings_;
   uint32_t record_columns_ = 0;
-  std::vector<double> record_;
+  std::unique_ptr<double[]> record_;  // --cycles rows, preallocated
+  FILE* record_file_ = nullptr;  // --record, opened before the first cycle
   volatile uint64_t cycle_ = 0;
   // Statistics (nanoseconds).
-  uint64_t overruns_ = 0, read_errors_ = 0, write_errors_ = 0, stale_reads_ = 0;
+  uint64_t overruns_ = 0, read_errors_ = 0, write_errors_ = 0, stale_reads_ = 0, never_reads_ = 0;
   int64_t max_lateness_ = 0, sum_lateness_ = 0;
   int64_t max_step_ = 0, sum_step_ = 0, max_cycle_ = 0, sum_cycle_ = 0;
 };

@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -21,6 +22,7 @@
 #include "fmu_binary.h"
 #include "mapping.h"
 #include "model_description.h"
+#include "hang_watch.h"
 #include "runner.h"
 
 namespace ccomm::fmu {
@@ -42,6 +44,8 @@ const char kUsage[] =
     "      --schema-dir DIR   also validate modelDescription.xml against DIR/fmi3 or fmi2 XSDs (xmllint)\n"
     "      --fmu-log          turn on the FMU's debug logging (messages go to stderr / the journal)\n"
     "      --measure          time each doStep and each whole cycle (two more clock readings per cycle)\n"
+    "      --hang-timeout TIME  a doStep running this long has hung: say so, exit 3 (default the\n"
+    "                         larger of 1 s and 100 periods; 0 turns the watch off)\n"
     "Exit status: 0 stopped by a signal or after --cycles; 1 refused at start; 3 the FMU failed;\n"
     "70 the FMU crashed; 75 ccommd replaced the segment (restart).\n";
 
@@ -162,7 +166,8 @@ int Main(int argc, char** argv) {
   std::string map_path, schema_dir;
   int64_t period_ns = 0;
   bool ignore_default_step = false;
-  enum { kIgnoreStep = 256, kCycles, kRecord, kPriority, kNoRt, kCpu, kSchema, kFmuLog, kMeasure };
+  enum { kIgnoreStep = 256, kCycles, kRecord, kPriority, kNoRt, kCpu, kSchema, kFmuLog, kMeasure, kHangTimeout };
+  int64_t hang_timeout_ns = -1;  // -1: the default, from the period
   static const option kLong[] = {
       {"node", required_argument, nullptr, 'n'},          {"period", required_argument, nullptr, 'p'},
       {"map", required_argument, nullptr, 'm'},           {"ignore-default-step", no_argument, nullptr, kIgnoreStep},
@@ -170,6 +175,7 @@ int Main(int argc, char** argv) {
       {"priority", required_argument, nullptr, kPriority}, {"no-rt", no_argument, nullptr, kNoRt},
       {"cpu", required_argument, nullptr, kCpu},          {"schema-dir", required_argument, nullptr, kSchema},
       {"fmu-log", no_argument, nullptr, kFmuLog},         {"measure", no_argument, nullptr, kMeasure},
+      {"hang-timeout", required_argument, nullptr, kHangTimeout},
       {nullptr, 0, nullptr, 0}};
   optind = 3;
   int ch;
@@ -203,6 +209,15 @@ int Main(int argc, char** argv) {
       case kSchema: schema_dir = optarg; break;
       case kFmuLog: opt.fmu_logging = true; break;
       case kMeasure: opt.measure = true; break;
+      case kHangTimeout:
+        if (std::strcmp(optarg, "0") == 0) {
+          hang_timeout_ns = 0;
+        } else if (!ParsePeriod(optarg, &hang_timeout_ns) || hang_timeout_ns < 4000000) {
+          std::fprintf(stderr, "ccomm-fmu: --hang-timeout %s: expected 0 (off) or a time from 4ms to 3600s like 1s, "
+                       "250ms\n", optarg);
+          return 1;
+        }
+        break;
       default: std::fputs(kUsage, stderr); return 1;
     }
   }
@@ -294,6 +309,12 @@ int Main(int argc, char** argv) {
     return 0;
   }
   g_cycle_for_crash = runner.cycle_counter();
+  if (hang_timeout_ns < 0) hang_timeout_ns = std::max<int64_t>(1000000000, 100 * opt.period_ns);
+  if (hang_timeout_ns > 0 && !StartHangWatch(hang_timeout_ns, md.model_name.c_str(), runner.cycle_counter(), &g_stop,
+                                             &error)) {
+    std::fprintf(stderr, "ccomm-fmu: %s\n", error.c_str());
+    return 1;
+  }
   return runner.Run(&g_stop);
 }
 

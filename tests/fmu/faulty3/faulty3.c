@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Test FMU (FMI 3.0): counts its steps on output "beat" until input "fault" asks it to fail:
-// 1 doStep returns Error, 2 Discard, 3 asks to terminate, 4 dereferences NULL (SIGSEGV).
+// 1 doStep returns Error, 2 Discard, 3 asks to terminate, 4 dereferences NULL (SIGSEGV),
+// 5 never returns (a hang).
 #include <stdlib.h>
 
 #include "fmi3_trivial.h"
@@ -39,6 +40,7 @@ fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
     case 2: return fmi3Discard;
     case 3: *terminate = fmi3True; break;
     case 4: { volatile int* volatile nowhere = NULL; *nowhere = 1; break; }
+    case 5: { volatile unsigned spin = 0; for (;;) spin = spin + 1; }
     default: break;
   }
   f->beat += 1;

@@ -23,10 +23,7 @@ bool IsName(const std::string& s) {  // FMI names may hold '.', '[', ']', ',' (F
 
 bool LoadMapping(const std::string& path, std::vector<MappingLine>* out, std::string* error) {
   std::string text;
-  if (!ReadFile(path, &text)) {
-    *error = path + ": cannot read";
-    return false;
-  }
+  if (!ReadFile(path, &text, error)) return false;
   return ParseMapping(path, text, out, error);
 }
 

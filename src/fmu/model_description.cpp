@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "model_description.h"
 
+#include <cerrno>
 #include <cmath>
 #include <csetjmp>
 #include <cstdio>
@@ -234,14 +235,18 @@ const Variable* ModelDescription::Find(const std::string& name) const {
   return nullptr;
 }
 
-bool ReadFile(const std::string& path, std::string* out) {
+bool ReadFile(const std::string& path, std::string* out, std::string* error) {
   FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return false;
+  if (f == nullptr) {
+    *error = path + ": cannot read: " + std::strerror(errno);
+    return false;
+  }
   char buf[65536];
   size_t n;
   out->clear();
   while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out->append(buf, n);
-  bool ok = std::ferror(f) == 0;
+  if (std::ferror(f) != 0) *error = path + ": cannot read: " + std::strerror(errno);
+  const bool ok = std::ferror(f) == 0;
   std::fclose(f);
   return ok;
 }
@@ -269,10 +274,7 @@ rapidxml::xml_document<char>* ParseXml(const std::string& path, const std::strin
 }
 rapidxml::xml_document<char>* ParseXmlFile(const std::string& path, std::string* buffer, std::string* error) {
   std::string text;
-  if (!ReadFile(path, &text)) {
-    *error = path + ": cannot read";
-    return nullptr;
-  }
+  if (!ReadFile(path, &text, error)) return nullptr;
   return ParseXml(path, text, buffer, error);
 }
 }  // namespace
@@ -292,10 +294,7 @@ bool ParseModelDescription(const std::string& path, const std::string& text, Mod
 
 bool LoadModelDescription(const std::string& path, ModelDescription* out, std::string* error) {
   std::string text;
-  if (!ReadFile(path, &text)) {
-    *error = path + ": cannot read";
-    return false;
-  }
+  if (!ReadFile(path, &text, error)) return false;
   return ParseModelDescription(path, text, out, error);
 }
 

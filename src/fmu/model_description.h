@@ -51,7 +51,7 @@ bool LoadBuildDescription(const std::string& path, const std::string& model_iden
                           std::string* error);
 
 // Reads a whole file; false if it cannot.
-bool ReadFile(const std::string& path, std::string* out);
+bool ReadFile(const std::string& path, std::string* out, std::string* error);  // error: "PATH: cannot read: why"
 
 }  // namespace ccomm::fmu
 #endif

@@ -90,8 +90,11 @@ Runner::~Runner() {
 bool Runner::Bind(const std::vector<MappingLine>& mapping, const std::string& map_path, std::string* error) {
   int rc = ccomm_open(opt_.node, CCOMM_OPEN_BATCH, &client_);
   if (rc != 0) {
-    *error = std::string("cannot attach to node ") + (opt_.node ? opt_.node : "(default)") + ": " +
-             ccomm_strerror(rc) + " (is ccommd running?)";
+    const char* env = std::getenv("CCOMM_NODE");
+    const std::string node = opt_.node     ? std::string(opt_.node)
+                             : env && *env ? std::string(env) + " (from $CCOMM_NODE)"
+                                           : std::string("of this host name (no --node, no $CCOMM_NODE)");
+    *error = "cannot attach to node " + node + ": " + ccomm_strerror(rc);
     return false;
   }
   std::map<std::string, const MappingLine*> by_variable;

@@ -115,7 +115,6 @@ void Supervisor::SuperviseClock(uint64_t now) {
   self.clock_path_delay_ns.store(static_cast<uint64_t>(ptp_.path_delay_ns()), std::memory_order_relaxed);
   self.clock_state.store(word, std::memory_order_release);
   handoffs_.PublishSelfClock(ptp_.state() == ptp::ClockState::kSynced, platform::RealtimeOffsetNs());
-  SuperviseSendCycle(now, ptp_.state() == ptp::ClockState::kSynced);
   const uint64_t by_arrival = handoffs_.by_arrival_frames.load(std::memory_order_relaxed);
   if (by_arrival != by_arrival_logged_ && now >= by_arrival_next_log_ns_) {
     Log(LogLevel::kNotice, "%llu frame(s) with stale_by=\"production\" values judged by their arrival: this "
@@ -124,7 +123,12 @@ void Supervisor::SuperviseClock(uint64_t now) {
     by_arrival_logged_ = by_arrival;
     by_arrival_next_log_ns_ = now + 10000000000ull;
   }
-  if (!changed) return;
+  if (changed) LogClockChange();
+  // After the clock's own line: the send cycle's re-alignment follows from it.
+  SuperviseSendCycle(now, ptp_.state() == ptp::ClockState::kSynced);
+}
+
+void Supervisor::LogClockChange() {
   const char* name = ptp::ClockStateName(ptp_.state());
   switch (ptp_.state()) {
     case ptp::ClockState::kSynced:

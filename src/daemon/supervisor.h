@@ -48,6 +48,7 @@ class Supervisor {
 
  private:
   void SuperviseClock(uint64_t now);  // this board's clock into the segment and the log
+  void LogClockChange();  // the clock state it changed to, one line
   void SuperviseSendCycle(uint64_t now, bool synced);  // send_cycle_daemon.cpp
 
   // Shared with the other parts (Daemon owns them).

@@ -395,6 +395,20 @@ TEST_F(ClientTest, RetiredSegmentIsReported) {
   EXPECT_EQ(s.write(1.0f), CCOMM_E_RETIRED);
 }
 
+// ccomm.hpp: error() says why "the open or the last signal() failed (0: it did not)", so a
+// successful signal() after a failed one reads 0, not the earlier failure.
+TEST_F(ClientTest, CppErrorIsClearedByASuccessfulSignal) {
+  ccomm::Client c("a");
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ(c.error(), 0);
+  EXPECT_FALSE(c.signal<double>("missing").valid());
+  EXPECT_EQ(c.error(), CCOMM_E_NOENT);
+  EXPECT_FALSE(c.signal<double>("arr").valid());
+  EXPECT_EQ(c.error(), CCOMM_E_TYPE);
+  EXPECT_TRUE((c.signal<std::array<int32_t, 3>>("arr").valid()));
+  EXPECT_EQ(c.error(), 0);
+}
+
 // A consumer asleep in ccomm_wait() when ccommd replaces the segment (new configuration)
 // is woken and told CCOMM_E_RETIRED, as reads and writes are; before, nothing rang the
 // old segment's doorbell again and it slept until its timeout (forever with -1).

@@ -102,6 +102,19 @@ def test_write_checks(client: Client) -> None:
         client.write("i32", [2**31, 0, 0])
     with pytest.raises(OverflowError):
         client.write("u32", -1)
+    # Floats at the edge: 2.0**63 equals float(2**63 - 1), so a float64 comparison let it
+    # through and it wrapped to -2**63; a float beyond float32 became inf.
+    for too_big in (2.0**63, np.float64(2.0**63), [2.0**63]):
+        with pytest.raises(OverflowError):
+            client.write("i64", too_big)
+    client.write("i64", -(2.0**63))
+    assert client.read("i64").value == -(2**63)
+    with pytest.raises(OverflowError):
+        client.write("u32", 2.0**32)
+    with pytest.raises(OverflowError):
+        client.write("f", 1e39)
+    client.write("f", float("inf"))  # inf and nan stay writable, as in signals.xml
+    assert client.read("f").value == float("inf")
     with pytest.raises(ValueError):
         client.write("flag", 2)
     with pytest.raises(TypeError):

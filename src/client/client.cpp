@@ -429,6 +429,12 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
   // Bounded by the deadline; a wake-up for a change another waiter consumed, or a
   // signal, sleeps again.
   while (!changed) {
+    // After the look at rx_doorbell: a retirement after it also bumps the doorbell, so
+    // the wait below returns at once (UnlinkThenRetire).
+    if (Retired(c)) {
+      h->rx_waiters.fetch_sub(1, std::memory_order_seq_cst);
+      return CCOMM_E_RETIRED;
+    }
     int64_t left = -1;
     if (timeout_ms >= 0) {
       uint64_t now = ccomm::platform::MonotonicNs();

@@ -395,6 +395,50 @@ TEST_F(ClientTest, RetiredSegmentIsReported) {
   EXPECT_EQ(s.write(1.0f), CCOMM_E_RETIRED);
 }
 
+// ccomm.hpp: error() says why "the open or the last signal() failed (0: it did not)", so a
+// successful signal() after a failed one reads 0, not the earlier failure.
+TEST_F(ClientTest, CppErrorIsClearedByASuccessfulSignal) {
+  ccomm::Client c("a");
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ(c.error(), 0);
+  EXPECT_FALSE(c.signal<double>("missing").valid());
+  EXPECT_EQ(c.error(), CCOMM_E_NOENT);
+  EXPECT_FALSE(c.signal<double>("arr").valid());
+  EXPECT_EQ(c.error(), CCOMM_E_TYPE);
+  EXPECT_TRUE((c.signal<std::array<int32_t, 3>>("arr").valid()));
+  EXPECT_EQ(c.error(), 0);
+}
+
+// A consumer asleep in ccomm_wait() when ccommd replaces the segment (new configuration)
+// is woken and told CCOMM_E_RETIRED, as reads and writes are; before, nothing rang the
+// old segment's doorbell again and it slept until its timeout (forever with -1).
+TEST_F(ClientTest, WaitReturnsRetiredWhenTheSegmentIsReplaced) {
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  ccomm_wait(c, 0);  // consume "changed since the open"
+  std::atomic<int> result{1000};
+  std::thread waiter([&] { result = ccomm_wait(c, 30000); });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (seg_a_.header()->rx_waiters.load() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(seg_a_.header()->rx_waiters.load(), 1u);
+  SystemConfig changed = cfg_;
+  changed.signals[2].count = 4;
+  changed.hash += 1;
+  store::Segment replacement;
+  std::string err;
+  bool adopted = true;
+  ASSERT_EQ(CreateOrAdoptSegment(&replacement, changed, 0, store::SegmentName("a"), -1, &adopted, &err), 0) << err;
+  EXPECT_FALSE(adopted);
+  const auto retired_at = std::chrono::steady_clock::now();
+  waiter.join();
+  EXPECT_EQ(result.load(), CCOMM_E_RETIRED);
+  EXPECT_LT(std::chrono::steady_clock::now() - retired_at, std::chrono::seconds(20));
+  EXPECT_EQ(ccomm_wait(c, 0), CCOMM_E_RETIRED);
+  EXPECT_EQ(ccomm_wait(c, -1), CCOMM_E_RETIRED);  // already retired: no sleep at all
+  ccomm_close(c);
+}
+
 // ccommd descheduled in the middle of rewriting a node record (the seqlock odd for
 // milliseconds, longer than the store's spinning reader tries) must not make a monitoring
 // tool drop that node (CI: `ccomm stats --all --json` printed "nodes":[, with node 0

@@ -219,7 +219,12 @@ static void UnlinkThenRetire(const std::string& name) {
   void* p = platform::FileSize(fd, &size) == 0 && size >= sizeof(SegmentHeader) ? platform::MapShared(fd, size) : nullptr;
   platform::CloseFd(fd);
   if (!p) return;
-  static_cast<SegmentHeader*>(p)->state.store(kRetired, std::memory_order_release);
+  SegmentHeader* h = static_cast<SegmentHeader*>(p);
+  h->state.store(kRetired, std::memory_order_release);
+  // Wakes clients asleep in ccomm_wait() on the old object: nothing else would ring it
+  // again, so they would sleep on forever instead of returning CCOMM_E_RETIRED.
+  h->rx_doorbell.fetch_add(1, std::memory_order_seq_cst);
+  platform::FutexWake(&h->rx_doorbell, 1 << 30);
   platform::Unmap(p, size);
 }
 

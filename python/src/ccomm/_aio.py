@@ -16,6 +16,7 @@ import ctypes
 from typing import Callable, Optional
 
 from . import _native
+from ._errors import error
 
 #: One wait of the worker thread; bounds how long close() and a cancelled wait take.
 SLICE_MS = 100
@@ -83,7 +84,7 @@ class ChangePump:
                 ev, self._changed = self._changed, asyncio.Event()
                 ev.set()
             if r < 0 and self._error is None:
-                self._error = RuntimeError(f"ccomm_wait failed: {r}")
+                self._error = error(r, "wait")  # RetiredError: ccommd replaced the segment
             if self._error is not None:
                 return
 

@@ -216,9 +216,15 @@ class Signal:
             else:
                 info = np.iinfo(i.dtype)
                 as_float = arr.astype(np.float64) if arr.dtype.kind == "f" else None
-                lo, hi = (as_float.min(), as_float.max()) if as_float is not None else (int(arr.min()), int(arr.max()))
+                # Python floats and ints compare exactly (numpy would round int64's max to 2.0**63).
+                lo, hi = ((float(as_float.min()), float(as_float.max())) if as_float is not None
+                          else (int(arr.min()), int(arr.max())))
                 if lo < info.min or hi > info.max:
                     raise OverflowError(f"{i.name}: value out of range for {i.type.name.lower()}: {value!r}")
+        elif i.dtype.kind == "f" and arr.dtype.kind == "f":
+            finite = np.isfinite(arr)  # inf and nan are values; a finite one must stay finite
+            if np.any(np.abs(arr[finite]) > np.finfo(i.dtype).max):
+                raise OverflowError(f"{i.name}: value out of range for {i.type.name.lower()}: {value!r}")
         self._view[...] = arr.astype(i.dtype)
         L, h = _native.lib(), self._client._handle()
         _check(L.ccomm_write(h, i.id, self._buf, i.value_bytes), f"write {i.name}")

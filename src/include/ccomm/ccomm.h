@@ -209,8 +209,9 @@ CCOMM_API int64_t ccomm_now(void);
  * Blocks until any signal of this node has changed (a value arrived from the network or
  * was written locally) since the previous ccomm_wait() on this handle returned (or since
  * ccomm_open), or `timeout_ms` passes (< 0: forever; 0: just look). Returns 1 if
- * something changed, 0 on timeout. A change between the caller's reads and this call is
- * never missed: it returns at once. Costs one look at every signal of the node; for
+ * something changed, 0 on timeout, CCOMM_E_RETIRED as soon as ccommd replaces the
+ * segment (new configuration: reopen), CCOMM_E_INVAL for a NULL handle. A change between
+ * the caller's reads and this call is never missed: it returns at once. Costs one look at every signal of the node; for
  * non-real-time consumers (a control loop just reads each cycle).
  */
 CCOMM_API int ccomm_wait(ccomm_client* c, int timeout_ms);

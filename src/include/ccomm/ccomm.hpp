@@ -173,6 +173,7 @@ class Client : private detail::Owned<ccomm_client> {
     ccomm_signal_desc d;
     ccomm_describe(h_, id, &d);
     if (d.type != TypeCode<E>::value || d.count != Element<T>::count) { error_ = CCOMM_E_TYPE; return Signal<T>(); }
+    error_ = 0;  // error() is about the last signal(): an earlier failure no longer counts
     return Signal<T>(h_, id);
   }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
+#include "cli/values.h"
 
 namespace {
 
@@ -185,7 +186,11 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   while ((ch = getopt_long(argc, argv, "ajw:", kLong, nullptr)) != -1) {
     if (ch == 'j') json = true;
     else if (ch == 'a') all = true;
-    else if (ch == 'w') watch = strtod(optarg, nullptr);
+    else if (ch == 'w' && ccomm::cli::ParseOptionNumber(optarg, false, false, &watch)) continue;
+    else if (ch == 'w') {
+      fprintf(stderr, "ccomm stats: --watch needs a positive number of seconds, not '%s'\n", optarg);
+      return 2;
+    }
     else return 2;
   }
   if (all) return CmdStatsAll(c, json, watch);

@@ -64,3 +64,30 @@ def test_subcommand_help_needs_no_daemon():
         cp = subprocess.run([os.path.join(BIN, "ccomm"), "--node", "no-such-node", sub, "--help"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=10)
         assert cp.returncode == 0 and cp.stdout.startswith("Usage: ccomm"), (sub, cp.returncode, cp.stderr)
+
+
+def test_option_numbers_are_checked_and_an_interrupted_echo_is_no_timeout(tmp_path):
+    """A bad number for an option is a usage error (exit 2, ccomm(1) EXIT STATUS), not read
+    as 0; echo -n N stopped by SIGINT before N values exits 0 (3 is for --timeout only)."""
+    import signal
+    import time
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        for args in (("echo", "camera_x", "-t", "abc"), ("echo", "camera_x", "-n", "0"),
+                     ("echo", "camera_x", "--interval", "x"), ("stats", "--watch", "abc"),
+                     ("stats", "--watch", "0"), ("pub", "camera_x", "1", "--count=abc"),
+                     ("pub", "camera_x", "1", "--count", "1.5"), ("pub", "camera_x", "1", "--rate")):
+            r = pair.cli("control", *args, check=False)
+            assert r.returncode == 2 and "needs a" in r.stderr, (args, r.returncode, r.stdout, r.stderr)
+        assert pair.cli("control", "pub", "camera_x", "2", "--count=2", "--rate=100").returncode == 0
+        reader = pair.spawn("control", "echo", "camera_x", "-n", "5")
+        deadline = time.time() + 10  # the reader prints the current value once attached
+        line = reader.stdout.readline()
+        assert line.split()[:2] == ["camera_x", "2"], line
+        assert time.time() < deadline
+        reader.send_signal(signal.SIGINT)
+        assert reader.wait(timeout=10) == 0
+        r = pair.cli("control", "echo", "camera_x", "-n", "5", "-t", "0.3", check=False)
+        assert r.returncode == 3, r  # the timeout still is

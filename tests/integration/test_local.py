@@ -3,7 +3,7 @@
 by ccommd for a local-only node)."""
 import os
 
-from harness import ROOT, NodePair
+from harness import BIN, ROOT, NodePair, run
 
 LOCAL = """<?xml version="1.0"?>
 <ccomm version="1">
@@ -91,3 +91,31 @@ def test_option_numbers_are_checked_and_an_interrupted_echo_is_no_timeout(tmp_pa
         assert reader.wait(timeout=10) == 0
         r = pair.cli("control", "echo", "camera_x", "-n", "5", "-t", "0.3", check=False)
         assert r.returncode == 3, r  # the timeout still is
+
+
+def test_latency_checks_its_options_and_prints_valid_json(tmp_path):
+    """ccomm-latency: a bad number is a usage error (exit 2; atof read 'abc' as 0, '5abc' as
+    5), an unwritable --samples file fails at the start (exit 1, not after the run with the
+    samples silently dropped), and any --label gives valid JSON."""
+    import json
+    import time
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        base = ["--send", "camera_x", "--recv", "camera_x", "--warmup", "0"]
+
+        def latency(*args, timeout=30):
+            return run(pair.exec_prefix("control") + [os.path.join(BIN, "ccomm-latency"), "--node", "control"]
+                       + base + list(args), check=False, env=pair.env, timeout=timeout)
+        for args in (("-r", "5abc", "-d", "0.2"), ("-d", "abc"), ("--warmup", "zz", "-d", "0.2"),
+                     ("--prio", "x", "-d", "0.2"), ("-d", "1e8")):
+            r = latency(*args)
+            assert r.returncode == 2 and r.stdout == "", (args, r.returncode, r.stdout, r.stderr)
+        t0 = time.time()
+        r = latency("-d", "20", "--samples", str(tmp_path / "no-such-dir" / "s.txt"))
+        assert r.returncode == 1 and "cannot write" in r.stderr, r
+        assert time.time() - t0 < 15  # refused at the start, not after the 20 s run
+        r = latency("-d", "0.2", "--label", 'say "hi"\\ \t')
+        assert r.returncode == 0, r
+        assert json.loads(r.stdout)["label"] == 'say "hi"\\ \t'

@@ -399,6 +399,11 @@ def record(a: argparse.Namespace) -> int:
     if not ended:
         ended.append(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]))
     wcode = ended[0]
+    if wcode < 0:  # killed: it said nothing, and the file has no footer
+        print(f"record: the writer process was killed ({signal.Signals(-wcode).name}): the file it was "
+              "writing holds every chunk closed so far but no footer; ccomm-record --recover FILE "
+              "-o FIXED.mcap makes a complete file of it", file=sys.stderr)
+        return 1
     if wcode != 0:
         print(f"record: the writer process failed (exit {wcode}); see its message above",
               file=sys.stderr)

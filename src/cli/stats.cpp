@@ -174,6 +174,18 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
 
 int CmdStatsAll(ccomm_client* c, bool json, double watch);  // stats_all.cpp
 
+namespace {
+// A ccommd restarted with another configuration retires the segment: its counters stay
+// frozen where they were, so --watch stops and says so (ccomm(1), EXIT STATUS 1).
+bool Retired(ccomm_client* c) {
+  ccomm_signal_desc d;
+  if (ccomm_signal_count(c) <= 0 || ccomm_describe(c, 0, &d) != 0) return false;
+  std::vector<uint8_t> value(d.value_bytes);
+  ccomm_info info;
+  return ccomm_read(c, 0, value.data(), value.size(), &info) == CCOMM_E_RETIRED;
+}
+}  // namespace
+
 int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   bool json = false, all = false;
   double watch = 0;
@@ -204,6 +216,10 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   for (;;) {
     struct timespec ts = {static_cast<time_t>(watch), static_cast<long>((watch - static_cast<double>(static_cast<time_t>(watch))) * 1e9)};
     if (nanosleep(&ts, nullptr) != 0) break;
+    if (Retired(c)) {
+      fprintf(stderr, "ccomm stats: %s\n", ccomm_strerror(CCOMM_E_RETIRED));
+      return 1;
+    }
     Snapshot now = Take(c);
     if (!json) printf("\033[H\033[J");
     Print(c, &before, now, json);

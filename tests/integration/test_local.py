@@ -119,3 +119,25 @@ def test_latency_checks_its_options_and_prints_valid_json(tmp_path):
         r = latency("-d", "0.2", "--label", 'say "hi"\\ \t')
         assert r.returncode == 0, r
         assert json.loads(r.stdout)["label"] == 'say "hi"\\ \t'
+
+
+def test_stats_watch_stops_when_the_segment_is_retired(tmp_path):
+    """ccommd restarted with another configuration retires the segment (ccomm(1), EXIT
+    STATUS 1): stats --watch exits 1 saying so, instead of showing the old segment's frozen
+    counters (daemon_alive false) forever."""
+    import time
+    cfg, changed = tmp_path / "local.xml", tmp_path / "changed.xml"
+    cfg.write_text(LOCAL)
+    changed.write_text(LOCAL.replace("</ccomm>", '  <signal name="extra" type="double" producer="control"/>\n</ccomm>'))
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        watcher = pair.spawn("control", "stats", "--watch", "0.2", "--json")
+        assert watcher.stdout.readline().startswith("{")  # it runs
+        pair.stop("control")
+        pair.config = str(changed)
+        pair.start("control")
+        deadline = time.time() + 20
+        while watcher.poll() is None and time.time() < deadline:
+            time.sleep(0.1)
+        assert watcher.poll() == 1, "stats --watch still running on the retired segment"
+        assert "new configuration" in watcher.stderr.read()

@@ -242,6 +242,11 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
   const int64_t period_ns = rate > 0 ? static_cast<int64_t>(1e9 / rate) : 0;
   for (long i = 0; i < count && !g_stop; ++i) {
     int r = ccomm_write(c, s, buf.data(), buf.size());
+    if (r == CCOMM_E_FULL && ccomm_daemon_alive(c)) {  // the library's text blames a stopped ccommd
+      fprintf(stderr, "ccomm pub: %s: event queue full after %ld writes: ccommd has not sent the earlier "
+              "events yet (queue_depth in signals.xml; --rate spaces the writes)\n", d.name, i);
+      return 1;
+    }
     if (r != 0) {
       fprintf(stderr, "ccomm pub: %s: %s\n", d.name, ccomm_strerror(r));
       return 1;

@@ -141,3 +141,22 @@ def test_stats_watch_stops_when_the_segment_is_retired(tmp_path):
             time.sleep(0.1)
         assert watcher.poll() == 1, "stats --watch still running on the retired segment"
         assert "new configuration" in watcher.stderr.read()
+
+
+def test_pub_burst_into_a_full_event_queue_does_not_blame_a_running_ccommd(tmp_path):
+    """pub --count N of an event faster than ccommd sends: refused (exit 1) with a message
+    that says what happened, not the library's 'ccommd is not forwarding' while it runs."""
+    cfg = tmp_path / "events.xml"
+    cfg.write_text("""<?xml version="1.0"?>
+<ccomm version="1">
+  <network heartbeat_ms="20" peer_timeout_ms="200"/>
+  <node name="control" interface="eth0" ip="10.42.0.1" transport="udp"/>
+  <node name="planner" interface="eth0" ip="10.42.0.2" transport="udp"/>
+  <signal name="cmd" type="int32" kind="event" producer="control" consumers="planner" queue_depth="2"/>
+</ccomm>
+""")
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        r = pair.cli("control", "pub", "cmd", "1", "--count", "100000", check=False)
+        assert r.returncode == 1, r
+        assert "has not sent the earlier events yet" in r.stderr and "not forwarding" not in r.stderr, r.stderr

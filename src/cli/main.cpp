@@ -337,6 +337,10 @@ int main(int argc, char** argv) {
       return 0;
     }
   }
+  if (strcmp(cmd, "list") == 0 && sub_argc > 1) {
+    fprintf(stderr, "ccomm list: takes no arguments, not '%s'\n", sub_argv[1]);
+    return 2;
+  }
   ccomm_client* c = nullptr;
   if (Open(node, &c) != 0) return 1;
   int r = 2;

@@ -205,6 +205,10 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
     }
     else return 2;
   }
+  if (optind < argc) {
+    fprintf(stderr, "ccomm stats: unexpected argument '%s'\n", argv[optind]);
+    return 2;
+  }
   if (all) return CmdStatsAll(c, json, watch);
   Snapshot before = Take(c);
   if (watch <= 0) {

@@ -81,6 +81,9 @@ def test_option_numbers_are_checked_and_an_interrupted_echo_is_no_timeout(tmp_pa
                      ("pub", "camera_x", "1", "--count", "1.5"), ("pub", "camera_x", "1", "--rate")):
             r = pair.cli("control", *args, check=False)
             assert r.returncode == 2 and "needs a" in r.stderr, (args, r.returncode, r.stdout, r.stderr)
+        for args in (("list", "extra"), ("list", "--bogus"), ("stats", "extra")):  # nothing ignored
+            r = pair.cli("control", *args, check=False)
+            assert r.returncode == 2 and r.stdout == "", (args, r.returncode, r.stdout, r.stderr)
         assert pair.cli("control", "pub", "camera_x", "2", "--count=2", "--rate=100").returncode == 0
         reader = pair.spawn("control", "echo", "camera_x", "-n", "5")
         deadline = time.time() + 10  # the reader prints the current value once attached

@@ -90,3 +90,20 @@ def test_publish_time_is_the_production_time_when_known_else_the_receive_time(tm
         ma, mb = json.loads(a_data), json.loads(b_data)
         assert (ma["production_time_ns"], ma["production_error_ns"], ma["age_code"]) == (produced, 7000, "synced")
         assert (mb["production_time_ns"], mb["production_error_ns"], mb["age_code"]) == (None, None, "local_unsynced")
+
+
+def test_an_unwritable_stats_json_is_an_error_that_says_why_and_the_recording_is_complete(
+        tmp_path: Path, capfd: pytest.CaptureFixture) -> None:
+    import os
+
+    from ccomm.mcap_io.writer import run_writer
+    rfd, wfd = os.pipe()
+    os.write(wfd, value(0, 1, 1000 * MS) + watermark(1001 * MS))
+    os.close(wfd)  # the capture ended: the writer completes the file
+    out, stats = tmp_path / "w.mcap", tmp_path / "no-such-dir" / "s.json"
+    code = run_writer(rfd, WriterOptions(output=str(out), signals=[signal(0, "a")], node="monitor",
+                                         progress="none", stats_json=str(stats)))
+    os.close(rfd)
+    assert code == 1
+    assert f"cannot write {stats}" in capfd.readouterr().err
+    assert log_times(out) == [("a", 1000 * MS)]  # the recording itself is complete and readable

@@ -133,11 +133,22 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
   optind = 0;  // 0: GNU getopt fully re-initialises (1 keeps stale permutation state)
   int ch;
   while ((ch = getopt_long(argc, argv, "n:t:", kLong, nullptr)) != -1) {
-    if (ch == 'n') count = strtol(optarg, nullptr, 10);
-    else if (ch == 't') timeout = strtod(optarg, nullptr);
-    else if (ch == 'o') once = true;
-    else if (ch == 'i') interval_ms = strtol(optarg, nullptr, 10);
-    else return 2;
+    double v = 0;
+    if (ch == 'o') {
+      once = true;
+      continue;
+    }
+    if (ch != 'n' && ch != 't' && ch != 'i') return 2;
+    // --timeout is seconds (decimal, 0 allowed); --count and --interval whole numbers > 0
+    if (!ccomm::cli::ParseOptionNumber(optarg, ch != 't', ch == 't', &v)) {
+      fprintf(stderr, "ccomm echo: %s needs a %s, not '%s'\n",
+              ch == 'n' ? "--count" : ch == 't' ? "--timeout" : "--interval",
+              ch == 't' ? "number of seconds >= 0" : "whole number > 0", optarg);
+      return 2;
+    }
+    if (ch == 'n') count = static_cast<long>(v);
+    else if (ch == 't') timeout = v;
+    else interval_ms = static_cast<long>(v);
   }
   if (optind != argc - 1) {
     fprintf(stderr, "ccomm echo: give exactly one SIGNAL\n");
@@ -179,7 +190,8 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
       ccomm_wait(c, 100);
     }
   }
-  return (count >= 0 && printed < count) ? 3 : 0;
+  // 3 only for --timeout (ccomm(1), EXIT STATUS); ^C or SIGTERM before N values is a normal stop
+  return (count >= 0 && printed < count && !g_stop) ? 3 : 0;
 }
 
 int CmdPub(ccomm_client* c, int argc, char** argv) {
@@ -189,20 +201,23 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
   std::vector<char*> pos;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    bool opt_rate = a == "--rate" || a == "-r", opt_count = a == "--count" || a == "-n";
-    if ((opt_rate || opt_count) && i + 1 < argc) {
-      char* end = nullptr;
-      double v = strtod(argv[++i], &end);
-      if (*end || v <= 0) {
-        fprintf(stderr, "ccomm pub: %s needs a positive number, not '%s'\n", a.c_str(), argv[i]);
+    bool opt_rate = a == "--rate" || a == "-r" || a.rfind("--rate=", 0) == 0;
+    bool opt_count = a == "--count" || a == "-n" || a.rfind("--count=", 0) == 0;
+    if (opt_rate || opt_count) {
+      size_t eq = a.find('=');
+      if (eq == std::string::npos && i + 1 >= argc) {
+        fprintf(stderr, "ccomm pub: %s needs a value\n", a.c_str());
+        return 2;
+      }
+      const char* text = eq == std::string::npos ? argv[++i] : argv[i] + eq + 1;
+      double v = 0;
+      if (!ccomm::cli::ParseOptionNumber(text, opt_count, false, &v)) {
+        fprintf(stderr, "ccomm pub: %s needs a %s, not '%s'\n", opt_rate ? "--rate" : "--count",
+                opt_rate ? "positive number" : "whole number > 0", text);
         return 2;
       }
       if (opt_rate) rate = v;
       else count = static_cast<long>(v);
-    } else if (a.rfind("--rate=", 0) == 0) {
-      rate = strtod(a.c_str() + 7, nullptr);
-    } else if (a.rfind("--count=", 0) == 0) {
-      count = strtol(a.c_str() + 8, nullptr, 10);
     } else if (a.size() > 1 && a[0] == '-' && !ccomm::cli::LooksLikeNumber(argv[i])) {
       fprintf(stderr, "ccomm pub: unknown option '%s'\n", a.c_str());
       return 2;
@@ -227,6 +242,11 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
   const int64_t period_ns = rate > 0 ? static_cast<int64_t>(1e9 / rate) : 0;
   for (long i = 0; i < count && !g_stop; ++i) {
     int r = ccomm_write(c, s, buf.data(), buf.size());
+    if (r == CCOMM_E_FULL && ccomm_daemon_alive(c)) {  // the library's text blames a stopped ccommd
+      fprintf(stderr, "ccomm pub: %s: event queue full after %ld writes: ccommd has not sent the earlier "
+              "events yet (queue_depth in signals.xml; --rate spaces the writes)\n", d.name, i);
+      return 1;
+    }
     if (r != 0) {
       fprintf(stderr, "ccomm pub: %s: %s\n", d.name, ccomm_strerror(r));
       return 1;
@@ -316,6 +336,10 @@ int main(int argc, char** argv) {
       fputs(kUsage, stdout);
       return 0;
     }
+  }
+  if (strcmp(cmd, "list") == 0 && sub_argc > 1) {
+    fprintf(stderr, "ccomm list: takes no arguments, not '%s'\n", sub_argv[1]);
+    return 2;
   }
   ccomm_client* c = nullptr;
   if (Open(node, &c) != 0) return 1;

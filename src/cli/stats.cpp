@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
+#include "cli/values.h"
 
 namespace {
 
@@ -173,6 +174,18 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
 
 int CmdStatsAll(ccomm_client* c, bool json, double watch);  // stats_all.cpp
 
+namespace {
+// A ccommd restarted with another configuration retires the segment: its counters stay
+// frozen where they were, so --watch stops and says so (ccomm(1), EXIT STATUS 1).
+bool Retired(ccomm_client* c) {
+  ccomm_signal_desc d;
+  if (ccomm_signal_count(c) <= 0 || ccomm_describe(c, 0, &d) != 0) return false;
+  std::vector<uint8_t> value(d.value_bytes);
+  ccomm_info info;
+  return ccomm_read(c, 0, value.data(), value.size(), &info) == CCOMM_E_RETIRED;
+}
+}  // namespace
+
 int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   bool json = false, all = false;
   double watch = 0;
@@ -185,8 +198,16 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   while ((ch = getopt_long(argc, argv, "ajw:", kLong, nullptr)) != -1) {
     if (ch == 'j') json = true;
     else if (ch == 'a') all = true;
-    else if (ch == 'w') watch = strtod(optarg, nullptr);
+    else if (ch == 'w' && ccomm::cli::ParseOptionNumber(optarg, false, false, &watch)) continue;
+    else if (ch == 'w') {
+      fprintf(stderr, "ccomm stats: --watch needs a positive number of seconds, not '%s'\n", optarg);
+      return 2;
+    }
     else return 2;
+  }
+  if (optind < argc) {
+    fprintf(stderr, "ccomm stats: unexpected argument '%s'\n", argv[optind]);
+    return 2;
   }
   if (all) return CmdStatsAll(c, json, watch);
   Snapshot before = Take(c);
@@ -199,6 +220,10 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   for (;;) {
     struct timespec ts = {static_cast<time_t>(watch), static_cast<long>((watch - static_cast<double>(static_cast<time_t>(watch))) * 1e9)};
     if (nanosleep(&ts, nullptr) != 0) break;
+    if (Retired(c)) {
+      fprintf(stderr, "ccomm stats: %s\n", ccomm_strerror(CCOMM_E_RETIRED));
+      return 1;
+    }
     Snapshot now = Take(c);
     if (!json) printf("\033[H\033[J");
     Print(c, &before, now, json);

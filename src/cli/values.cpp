@@ -4,6 +4,8 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
+
+#include <cmath>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,6 +108,16 @@ bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std:
   size_t es = ElemSize(d.type);
   for (uint32_t i = 0; i < d.count; ++i)
     if (!ParseOne(d.type, parts.size() == 1 ? parts[0] : parts[i], p + i * es, error)) return false;
+  return true;
+}
+
+bool ParseOptionNumber(const char* word, bool integer, bool allow_zero, double* out) {
+  char* end = nullptr;
+  errno = 0;
+  double v = strtod(word, &end);
+  if (end == word || *end || errno == ERANGE || !std::isfinite(v)) return false;
+  if (v < 0 || (v == 0 && !allow_zero) || (integer && (v != std::floor(v) || v > 9e15))) return false;
+  *out = v;
   return true;
 }
 

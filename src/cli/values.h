@@ -18,6 +18,9 @@ std::string FormatValue(const ccomm_signal_desc& d, const void* value);
 bool ParseValue(const ccomm_signal_desc& d, int n, char** words, void* out, std::string* error);
 /// True if `word` is a number ("-1.5", "-inf", "-nan"): a value, not an option.
 bool LooksLikeNumber(const char* word);
+/// An option's number: the whole word a finite decimal > 0 (>= 0 with allow_zero), and
+/// integral when `integer`; false for "abc", "1x", "-1", "1.5" (integer), "inf".
+bool ParseOptionNumber(const char* word, bool integer, bool allow_zero, double* out);
 
 }  // namespace cli
 }  // namespace ccomm

@@ -9,6 +9,7 @@
 //   oneway: arrival - producer's write time (same clock: namespaces on one host)
 //   ping:   the peer runs --mode echo and sends k back; RTT/2 = (arrival - send of k)/2
 // Loss = cycles in the observed range that never arrived complete.
+#include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
 #include <pthread.h>
@@ -234,6 +235,31 @@ std::vector<ccomm_signal> Resolve(ccomm_client* c, const std::string& list, bool
 
 }  // namespace
 
+// An option's number, the whole word (atof read "abc" as 0 and "5abc" as 5); false if not.
+bool Number(const char* word, double* out) {
+  char* end = nullptr;
+  double v = strtod(word, &end);
+  if (end == word || *end || !(v == v) || v > 1e15 || v < -1e15) return false;
+  *out = v;
+  return true;
+}
+
+// The label as a JSON string's contents: quotes, backslashes and control characters escaped.
+std::string JsonEscaped(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c < 0x20) {
+      char hex[8];
+      snprintf(hex, sizeof hex, "\\u%04x", c);
+      out += hex;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 int main(int argc, char** argv) {
   Options o;
   static const struct option kLong[] = {
@@ -248,21 +274,26 @@ int main(int argc, char** argv) {
       {"help", no_argument, nullptr, 'h'},         {nullptr, 0, nullptr, 0}};
   int ch;
   while ((ch = getopt_long(argc, argv, "n:r:d:m:h", kLong, nullptr)) != -1) {
+    double v = 0;
+    if (strchr("rdWPQC", ch) != nullptr && !Number(optarg, &v)) {
+      fprintf(stderr, "ccomm-latency: '%s' is not a number\n", optarg);
+      return 2;
+    }
     switch (ch) {
       case 'n': o.node = optarg; break;
-      case 'r': o.rate = atof(optarg); break;
-      case 'd': o.duration = atof(optarg); break;
+      case 'r': o.rate = v; break;
+      case 'd': o.duration = v; break;
       case 'm': o.mode = optarg; break;
       case 'S': o.send = optarg; break;
       case 'R': o.recv = optarg; break;
-      case 'W': o.warmup = atof(optarg); break;
-      case 'P': o.prio = atoi(optarg); break;
-      case 'Q': o.rx_prio = atoi(optarg); break;
+      case 'W': o.warmup = v; break;
+      case 'P': o.prio = static_cast<int>(v); break;
+      case 'Q': o.rx_prio = static_cast<int>(v); break;
       case 'L': o.label = optarg; break;
       case 'F': o.samples_file = optarg; break;
       case 'G': o.stages_file = optarg; break;
       case 'X': o.spin = true; break;
-      case 'C': o.cpu = atoi(optarg); break;
+      case 'C': o.cpu = static_cast<int>(v); break;
       case 'h': fputs(kUsage, stdout); return 0;
       default: fputs(kUsage, stderr); return 2;
     }
@@ -270,6 +301,19 @@ int main(int argc, char** argv) {
   if (o.rate <= 0 || o.duration <= 0 || (o.mode != "oneway" && o.mode != "ping" && o.mode != "echo")) {
     fputs(kUsage, stderr);
     return 2;
+  }
+  if (o.rate * o.duration > 1e8) {  // the samples are preallocated: 16 bytes a cycle
+    fprintf(stderr, "ccomm-latency: at most 1e8 cycles (rate x duration) per run\n");
+    return 2;
+  }
+  // The output files are opened now: a run is not wasted on a file that cannot be written.
+  FILE* samples_out = nullptr;
+  FILE* stages_out = nullptr;
+  for (auto [name, file] : {std::make_pair(&o.samples_file, &samples_out), std::make_pair(&o.stages_file, &stages_out)}) {
+    if (!name->empty() && (*file = fopen(name->c_str(), "w")) == nullptr) {
+      fprintf(stderr, "ccomm-latency: cannot write %s: %s\n", name->c_str(), strerror(errno));
+      return 1;
+    }
   }
   Shared s;
   int r = ccomm_open(o.node, CCOMM_OPEN_BATCH, &s.tx_client);
@@ -354,25 +398,21 @@ int main(int argc, char** argv) {
   if (!v.empty()) mean /= static_cast<double>(v.size());
   uint64_t expected = s.any ? s.last_k - s.first_k + 1 : 0;
   uint64_t lost = expected > s.received ? expected - s.received : 0;
-  if (!o.samples_file.empty()) {
-    if (FILE* f = fopen(o.samples_file.c_str(), "w")) {
-      for (int64_t x : s.samples) fprintf(f, "%" PRId64 "\n", x);
-      fclose(f);
-    }
+  if (samples_out != nullptr) {
+    for (int64_t x : s.samples) fprintf(samples_out, "%" PRId64 "\n", x);
+    fclose(samples_out);
   }
-  if (!o.stages_file.empty()) {
-    if (FILE* f = fopen(o.stages_file.c_str(), "w")) {
-      for (size_t i = 0; i < s.samples.size(); ++i)
-        fprintf(f, "%" PRId64 "\t%" PRId64 "\n", s.samples[i], s.last_hop[i]);
-      fclose(f);
-    }
+  if (stages_out != nullptr) {
+    for (size_t i = 0; i < s.samples.size(); ++i)
+      fprintf(stages_out, "%" PRId64 "\t%" PRId64 "\n", s.samples[i], s.last_hop[i]);
+    fclose(stages_out);
   }
   printf("{\"label\":\"%s\",\"mode\":\"%s\",\"node\":\"%s\",\"rate_hz\":%.0f,\"send_signals\":%zu,"
          "\"recv_signals\":%zu,\"sent\":%" PRIu64 ",\"received\":%" PRIu64 ",\"lost\":%" PRIu64
          ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
          ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu,"
          "\"overruns\":%" PRIu64 ",\"first_k\":%" PRIu64 ",\"last_k\":%" PRIu64 "}\n",
-         o.label.c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
+         JsonEscaped(o.label).c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
          s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
          v.empty() ? -1 : v.back(), mean, v.size(), overruns, s.first_k, s.last_k);
   ccomm_close(s.tx_client);

@@ -3,7 +3,7 @@
 by ccommd for a local-only node)."""
 import os
 
-from harness import ROOT, NodePair
+from harness import BIN, ROOT, NodePair, run
 
 LOCAL = """<?xml version="1.0"?>
 <ccomm version="1">
@@ -64,3 +64,102 @@ def test_subcommand_help_needs_no_daemon():
         cp = subprocess.run([os.path.join(BIN, "ccomm"), "--node", "no-such-node", sub, "--help"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=10)
         assert cp.returncode == 0 and cp.stdout.startswith("Usage: ccomm"), (sub, cp.returncode, cp.stderr)
+
+
+def test_option_numbers_are_checked_and_an_interrupted_echo_is_no_timeout(tmp_path):
+    """A bad number for an option is a usage error (exit 2, ccomm(1) EXIT STATUS), not read
+    as 0; echo -n N stopped by SIGINT before N values exits 0 (3 is for --timeout only)."""
+    import signal
+    import time
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        for args in (("echo", "camera_x", "-t", "abc"), ("echo", "camera_x", "-n", "0"),
+                     ("echo", "camera_x", "--interval", "x"), ("stats", "--watch", "abc"),
+                     ("stats", "--watch", "0"), ("pub", "camera_x", "1", "--count=abc"),
+                     ("pub", "camera_x", "1", "--count", "1.5"), ("pub", "camera_x", "1", "--rate")):
+            r = pair.cli("control", *args, check=False)
+            assert r.returncode == 2 and "needs a" in r.stderr, (args, r.returncode, r.stdout, r.stderr)
+        for args in (("list", "extra"), ("list", "--bogus"), ("stats", "extra")):  # nothing ignored
+            r = pair.cli("control", *args, check=False)
+            assert r.returncode == 2 and r.stdout == "", (args, r.returncode, r.stdout, r.stderr)
+        assert pair.cli("control", "pub", "camera_x", "2", "--count=2", "--rate=100").returncode == 0
+        reader = pair.spawn("control", "echo", "camera_x", "-n", "5")
+        deadline = time.time() + 10  # the reader prints the current value once attached
+        line = reader.stdout.readline()
+        assert line.split()[:2] == ["camera_x", "2"], line
+        assert time.time() < deadline
+        reader.send_signal(signal.SIGINT)
+        assert reader.wait(timeout=10) == 0
+        r = pair.cli("control", "echo", "camera_x", "-n", "5", "-t", "0.3", check=False)
+        assert r.returncode == 3, r  # the timeout still is
+
+
+def test_latency_checks_its_options_and_prints_valid_json(tmp_path):
+    """ccomm-latency: a bad number is a usage error (exit 2; atof read 'abc' as 0, '5abc' as
+    5), an unwritable --samples file fails at the start (exit 1, not after the run with the
+    samples silently dropped), and any --label gives valid JSON."""
+    import json
+    import time
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        base = ["--send", "camera_x", "--recv", "camera_x", "--warmup", "0"]
+
+        def latency(*args, timeout=30):
+            return run(pair.exec_prefix("control") + [os.path.join(BIN, "ccomm-latency"), "--node", "control"]
+                       + base + list(args), check=False, env=pair.env, timeout=timeout)
+        for args in (("-r", "5abc", "-d", "0.2"), ("-d", "abc"), ("--warmup", "zz", "-d", "0.2"),
+                     ("--prio", "x", "-d", "0.2"), ("-d", "1e8")):
+            r = latency(*args)
+            assert r.returncode == 2 and r.stdout == "", (args, r.returncode, r.stdout, r.stderr)
+        t0 = time.time()
+        r = latency("-d", "20", "--samples", str(tmp_path / "no-such-dir" / "s.txt"))
+        assert r.returncode == 1 and "cannot write" in r.stderr, r
+        assert time.time() - t0 < 15  # refused at the start, not after the 20 s run
+        r = latency("-d", "0.2", "--label", 'say "hi"\\ \t')
+        assert r.returncode == 0, r
+        assert json.loads(r.stdout)["label"] == 'say "hi"\\ \t'
+
+
+def test_stats_watch_stops_when_the_segment_is_retired(tmp_path):
+    """ccommd restarted with another configuration retires the segment (ccomm(1), EXIT
+    STATUS 1): stats --watch exits 1 saying so, instead of showing the old segment's frozen
+    counters (daemon_alive false) forever."""
+    import time
+    cfg, changed = tmp_path / "local.xml", tmp_path / "changed.xml"
+    cfg.write_text(LOCAL)
+    changed.write_text(LOCAL.replace("</ccomm>", '  <signal name="extra" type="double" producer="control"/>\n</ccomm>'))
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        watcher = pair.spawn("control", "stats", "--watch", "0.2", "--json")
+        assert watcher.stdout.readline().startswith("{")  # it runs
+        pair.stop("control")
+        pair.config = str(changed)
+        pair.start("control")
+        deadline = time.time() + 20
+        while watcher.poll() is None and time.time() < deadline:
+            time.sleep(0.1)
+        assert watcher.poll() == 1, "stats --watch still running on the retired segment"
+        assert "new configuration" in watcher.stderr.read()
+
+
+def test_pub_burst_into_a_full_event_queue_does_not_blame_a_running_ccommd(tmp_path):
+    """pub --count N of an event faster than ccommd sends: refused (exit 1) with a message
+    that says what happened, not the library's 'ccommd is not forwarding' while it runs."""
+    cfg = tmp_path / "events.xml"
+    cfg.write_text("""<?xml version="1.0"?>
+<ccomm version="1">
+  <network heartbeat_ms="20" peer_timeout_ms="200"/>
+  <node name="control" interface="eth0" ip="10.42.0.1" transport="udp"/>
+  <node name="planner" interface="eth0" ip="10.42.0.2" transport="udp"/>
+  <signal name="cmd" type="int32" kind="event" producer="control" consumers="planner" queue_depth="2"/>
+</ccomm>
+""")
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        r = pair.cli("control", "pub", "cmd", "1", "--count", "100000", check=False)
+        assert r.returncode == 1, r
+        assert "has not sent the earlier events yet" in r.stderr and "not forwarding" not in r.stderr, r.stderr

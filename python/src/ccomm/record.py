@@ -244,19 +244,21 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                     if r != 0:  # EMPTY: caught up
                         break
                     seq, src, recv, overrun, lost = unpack_hinfo(hinfo)
-                    age = t - recv
-                    if age > delay.max_ns:
-                        delay.max_ns = age
-                    if age >= 1_000_000:
-                        delay.over_1ms += 1
                     prev = last_seq[i]
+                    initial = prev == 0 and recv < start
+                    age = t - recv
+                    if not initial:  # a value from before the start did not wait for the capture
+                        if age > delay.max_ns:
+                            delay.max_ns = age
+                        if age >= 1_000_000:
+                            delay.over_1ms += 1
                     if prev == 0:
                         lost_so_far[i] = lost  # ccommd's count when recording starts
                     elif seq > prev + 1:
                         lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
                     last_seq[i], last_overrun[i] = seq, overrun
                     hist_info.seq, hist_info.source_time_ns = seq, src
-                    out += pack(sid, 0, FLAG_INITIAL if prev == 0 and recv < start else 0, seq, recv, src,
+                    out += pack(sid, 0, FLAG_INITIAL if initial else 0, seq, recv, src,
                                 lost_so_far[i], *production(sid, hist_info_addr))
                     out += view
                 continue
@@ -270,14 +272,17 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                 status, flags, seq, age, src, lost = unpack_info(info)
                 if seq != last_seq[i]:
                     last_seq[i] = seq
-                    if age > delay.max_ns:
-                        delay.max_ns = age
-                    if age >= 1_000_000:
-                        delay.over_1ms += 1
+                    initial = False
                     if not event and first[i]:  # a state's value already there at the start
                         first[i] = False
-                        if t - age < start:
+                        initial = t - age < start
+                        if initial:
                             flags |= FLAG_INITIAL
+                    if not initial:  # a value from before the start did not wait for the capture
+                        if age > delay.max_ns:
+                            delay.max_ns = age
+                        if age >= 1_000_000:
+                            delay.over_1ms += 1
                     out += pack(sid, status, flags, seq, t - age, src, lost, *production(sid, info_addr))
                     out += view
                 if not event:
@@ -394,6 +399,11 @@ def record(a: argparse.Namespace) -> int:
     if not ended:
         ended.append(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]))
     wcode = ended[0]
+    if wcode < 0:  # killed: it said nothing, and the file has no footer
+        print(f"record: the writer process was killed ({signal.Signals(-wcode).name}): the file it was "
+              "writing holds every chunk closed so far but no footer; ccomm-record --recover FILE "
+              "-o FIXED.mcap makes a complete file of it", file=sys.stderr)
+        return 1
     if wcode != 0:
         print(f"record: the writer process failed (exit {wcode}); see its message above",
               file=sys.stderr)

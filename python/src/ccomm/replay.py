@@ -199,8 +199,9 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
             written += 1
             if not quiet and now() - last_report >= 1_000_000_000:
                 last_report = now()
-                print(f"\rreplay: {(t - t0) / 1e9:7.1f} / {span / 1e9:.1f} s  {written} values",
-                      end="", file=sys.stderr, flush=True)
+                tty = sys.stderr.isatty()  # in place on a terminal, else a line each
+                print(("\r" if tty else "") + f"replay: {(t - t0) / 1e9:7.1f} / {span / 1e9:.1f} s  {written} values",
+                      end="" if tty else "\n", file=sys.stderr, flush=True)
         flush(handle)
         if not loop:
             break
@@ -242,6 +243,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                   f"{', '.join(skipped[:8])}{' ...' if len(skipped) > 8 else ''}", file=sys.stderr)
     if a.check or not timeline:
         return 0
+    stats_file = None
+    if a.stats_json:  # opened before writing anything: no replay ends in a traceback over it
+        try:
+            stats_file = open(a.stats_json, "w")
+        except OSError as e:
+            print(f"replay: cannot write {a.stats_json}: {e.strerror}", file=sys.stderr)
+            return 1
     stop: List[int] = []
     for s in (signal.SIGINT, signal.SIGTERM):
         signal.signal(s, lambda *_: stop.append(1))
@@ -268,13 +276,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     stats = {"values": written, "signals": len(chosen), "late_p50_ns": _percentile(late, 0.5),
              "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0, **why_late}
     if not a.quiet:
-        print(f"\rreplay: wrote {written} values; timing error p50 {stats['late_p50_ns'] / 1e3:.0f} us, "
+        print(("\r" if sys.stderr.isatty() else "") + f"replay: wrote {written} values; timing error p50 {stats['late_p50_ns'] / 1e3:.0f} us, "
               f"p99 {stats['late_p99_ns'] / 1e3:.0f} us, max {stats['late_max_ns'] / 1e3:.0f} us; waited for "
               f"ccommd to take a step {why_late['waits_over_1ms']} times 1 ms or more ({why_late['waited_ms']} ms "
               f"in all), {why_late['full_retries']} retries on a full event ring", file=sys.stderr)
-    if a.stats_json:
-        with open(a.stats_json, "w") as f:
-            json.dump(stats, f, indent=1)
+    if stats_file is not None:
+        with stats_file:
+            json.dump(stats, stats_file, indent=1)
     return 0
 
 

@@ -302,6 +302,10 @@ def run_writer(fd: int, o: WriterOptions) -> int:
                   f"their receive time (at most {s['logged_late_max_ms']} ms): logged at the newest log time "
                   f"then (their receive_time_ns is exact); the hold grew to {s['hold_ms']} ms", file=sys.stderr)
     if o.stats_json:
-        with open(o.stats_json, "w") as f:
-            json.dump(s, f, indent=1)
+        try:
+            with open(o.stats_json, "w") as f:
+                json.dump(s, f, indent=1)
+        except OSError as e:  # said here: the process ends in os._exit, which drops a traceback
+            print(f"record: cannot write {o.stats_json}: {e.strerror}", file=sys.stderr)
+            return 1
     return 0

@@ -116,10 +116,11 @@ def check_stamps(path: str, expect: str) -> int:
     return 0 if n > 0 and bad == 0 else 1
 
 
-def check_initial(path: str, signal: str, max_span_s: float) -> int:
+def check_initial(path: str, signal: str, max_span_s: float, status: str) -> int:
     """A recording started on a running system: `signal`'s first message is its value from
-    before the start, marked initial and logged at the start; every message lies within
-    max_span_s of the start; later messages are not initial."""
+    before the start, marked initial and logged at the start, with the status a read gave
+    then (`status`); every message lies within max_span_s of the start; later messages are
+    not initial."""
     with open(path, "rb") as f:
         r = make_reader(f)
         meta = {m.name: m.metadata for m in r.iter_metadata()}
@@ -133,9 +134,11 @@ def check_initial(path: str, signal: str, max_span_s: float) -> int:
     span = (max(times) - min(times)) / 1e9 if times else 0.0
     first = mine[0][1] if mine else {}
     old = (mine[0][0] - started) / 1e9 if mine else 0.0
-    print("# %s: %d messages, first initial=%s logged %.3f s after the start (its receive time is "
-          "older); file spans %.2f s (limit %.1f)" % (signal, len(mine), first.get("initial"), old, span, max_span_s))
-    ok = (len(mine) >= 2 and first.get("initial") is True and mine[0][0] >= started and
+    print("# %s: %d messages, first initial=%s status=%s (expected %s) logged %.3f s after the start (its "
+          "receive time is older); file spans %.2f s (limit %.1f)" % (signal, len(mine), first.get("initial"),
+                                                                     first.get("status"), status, old, span, max_span_s))
+    ok = (len(mine) >= 2 and first.get("initial") is True and first.get("status") == status and
+          mine[0][0] >= started and
           not any(m.get("initial") for _, m in mine[1:]) and span <= max_span_s)
     return 0 if ok else 1
 
@@ -502,8 +505,8 @@ def main() -> int:
         return check_stamps(sys.argv[2], sys.argv[3])
     if cmd == "order":  # FILE
         return check_order(sys.argv[2])
-    if cmd == "initial":  # FILE SIGNAL MAX_SPAN_S
-        return check_initial(sys.argv[2], sys.argv[3], float(sys.argv[4]))
+    if cmd == "initial":  # FILE SIGNAL MAX_SPAN_S STATUS
+        return check_initial(sys.argv[2], sys.argv[3], float(sys.argv[4]), sys.argv[5])
     if cmd == "config":
         make_config(*args)
         return 0

@@ -206,6 +206,16 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
         code, known, _age, err, ptime = unpack_page(page)
         return (ptime, err, code) if known else (-1, -1, code)
 
+    def initial_status(i: int, sid: int, size: int, seq: int) -> int:
+        # The status a read gives now for the value a history cursor starts at (the newest
+        # kept): stale when it is older than stale_after_ms. Read into a scratch buffer (a
+        # stale read returns the safe value, the history the value itself); fresh if a newer
+        # value arrived in between.
+        scratch = (ctypes.c_ubyte * size)()
+        r = read(handle, sid, ctypes.addressof(scratch), size, info_addr)
+        st, _flags, rseq, _age, _src, _lost = unpack_info(info)
+        return st if r in (0, 1) and rseq == seq else 0
+
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
     # A history cursor per received state when the node keeps history (from the newest
     # value kept: what polling would have read first), else None.
@@ -258,7 +268,10 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                         lost_so_far[i] += max(0, seq - prev - 1 - (overrun - last_overrun[i]))
                     last_seq[i], last_overrun[i] = seq, overrun
                     hist_info.seq, hist_info.source_time_ns = seq, src
-                    out += pack(sid, 0, FLAG_INITIAL if initial else 0, seq, recv, src,
+                    status = 0  # each value the history kept was fresh when ccommd stored it
+                    if initial:  # ... but one from before the start: as a read says now
+                        status = initial_status(i, sid, size, seq)
+                    out += pack(sid, status, FLAG_INITIAL if initial else 0, seq, recv, src,
                                 lost_so_far[i], *production(sid, hist_info_addr))
                     out += view
                 continue

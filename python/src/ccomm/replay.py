@@ -235,13 +235,18 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"replay: {e}", file=sys.stderr)
         return 2
     timeline = sorted((t, seq, d.id, data) for d, name in chosen for t, seq, data in rec.signals[name].values)
+    if not timeline:  # channels of this node's signals, but not one value in them
+        print(f"replay: {a.file} holds no value of the {len(chosen)} signal(s) node '{node}' produces "
+              f"({', '.join(name for _, name in chosen[:8])}{' ...' if len(chosen) > 8 else ''}): "
+              "nothing to replay", file=sys.stderr)
+        return 2
     if not a.quiet:
         print(f"replay: {len(timeline)} values of {len(chosen)} signals from {a.file} "
               f"(recorded on '{rec.node}') into node '{node}'", file=sys.stderr)
         if skipped:
             print(f"replay: skipped {len(skipped)} signals other nodes produce: "
                   f"{', '.join(skipped[:8])}{' ...' if len(skipped) > 8 else ''}", file=sys.stderr)
-    if a.check or not timeline:
+    if a.check:
         return 0
     stats_file = None
     if a.stats_json:  # opened before writing anything: no replay ends in a traceback over it

@@ -40,8 +40,8 @@ const char kUsage[] =
     "                           --all: every node of the system (alive, the peers it hears,\n"
     "                           its counters, per signal rate/loss/staleness/age), from the\n"
     "                           summaries the nodes exchange every <network summary_ms>\n"
-    "  gen 20sim4c SIGNALS.XML OUTDIR\n"
-    "                           generate the 20-sim 4C I/O component for this node\n"
+    "  gen 20sim4c SIGNALS.XML [NODE] OUTDIR\n"
+    "                           generate the 20-sim 4C I/O component for NODE (default: -n)\n"
     "  record, replay, web, ros2 ...\n"
     "                           run the installed tool ccomm-COMMAND (see its --help):\n"
     "                           MCAP recording and replay, live view, ROS 2 bridge\n"
@@ -260,6 +260,11 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
       if (now - next >= period_ns) next = now;
     }
   }
+  // Stored, but a segment outlives its ccommd: say that nothing leaves the board now.
+  if (!ccomm_daemon_alive(c))
+    fprintf(stderr, "ccomm pub: warning: no ccommd is running for node %s: %s stored for this board's readers, "
+            "not sent to other nodes until ccommd runs (systemctl start ccommd)\n", ccomm_node_name(c),
+            d.is_event ? "the event is queued" : "the value is");
   return 0;
 }
 

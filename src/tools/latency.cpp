@@ -52,9 +52,9 @@ const char kUsage[] =
     "      --stages FILE      oneway: write each sample as 'total<TAB>last hop' (ns), the last hop\n"
     "                         being the time since ccommd stored the newest value of the cycle\n"
     "                         on this node (so total - last hop = producer write -> ccommd here)\n"
-    "Prints one JSON line: {label,mode,rate_hz,sent,received,lost,min_ns,p50_ns,p90_ns,p99_ns,\n"
-    "p999_ns,max_ns,mean_ns,count,overruns,first_k,last_k}; overruns: cycles the sender skipped because it woke\n"
-    "a period late or more (a stalled machine), never written.\n";
+    "Prints one JSON line: {label,mode,node,rate_hz,send_signals,recv_signals,sent,received,lost,min_ns,\n"
+    "p50_ns,p90_ns,p99_ns,p999_ns,max_ns,mean_ns,count,overruns,first_k,last_k}; overruns: cycles the sender\n"
+    "skipped because it woke a period late or more (a stalled machine), never written.\n";
 
 struct Options {
   const char* node = nullptr;

@@ -163,3 +163,18 @@ def test_pub_burst_into_a_full_event_queue_does_not_blame_a_running_ccommd(tmp_p
         r = pair.cli("control", "pub", "cmd", "1", "--count", "100000", check=False)
         assert r.returncode == 1, r
         assert "has not sent the earlier events yet" in r.stderr and "not forwarding" not in r.stderr, r.stderr
+
+
+def test_pub_says_when_no_ccommd_runs(tmp_path):
+    """A segment outlives its ccommd (a restart adopts it): `ccomm pub` then stores the value
+    for this board's readers, exits 0, and warns that nothing is sent until ccommd runs."""
+    cfg = tmp_path / "local.xml"
+    cfg.write_text(LOCAL)
+    with NodePair(config=str(cfg)) as pair:
+        pair.start("control")
+        r = pair.cli("control", "pub", "camera_x", "1.5")
+        assert "warning" not in r.stderr, r.stderr
+        pair.stop("control")
+        r = pair.cli("control", "pub", "camera_x", "2.5", check=False)
+        assert r.returncode == 0, (r.returncode, r.stderr)
+        assert "no ccommd is running for node control" in r.stderr, r.stderr

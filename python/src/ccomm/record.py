@@ -214,7 +214,7 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
         scratch = (ctypes.c_ubyte * size)()
         r = read(handle, sid, ctypes.addressof(scratch), size, info_addr)
         st, _flags, rseq, _age, _src, _lost = unpack_info(info)
-        return st if r in (0, 1) and rseq == seq else 0
+        return int(st) if r in (0, 1) and rseq == seq else 0
 
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
     # A history cursor per received state when the node keeps history (from the newest

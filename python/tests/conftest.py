@@ -8,7 +8,7 @@ import os
 import subprocess
 import time
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Callable, Iterator, List, Optional
 
 import pytest
 
@@ -81,3 +81,42 @@ def client(node: str) -> Iterator["object"]:
 
     with ccomm.Client(node) as c:
         yield c
+
+
+@pytest.fixture
+def own_ccommd(build_dir: Path, node: str, tmp_path: Path) -> Iterator[Callable[..., None]]:
+    """A second ccommd for node "pytest" under a prefix and UDP port of its own (the session's
+    ccommd is left alone; CCOMM_SHM_PREFIX points at it while the test runs), started on
+    signals.xml. Yields restart(old=None, new=None): stops it and starts it again, on the
+    same file or with `old` replaced by `new` in it."""
+    saved = os.environ["CCOMM_SHM_PREFIX"]
+    prefix = f"/ccomm-pytest-own-{os.getpid()}."
+    os.environ["CCOMM_SHM_PREFIX"] = prefix
+    base = (HERE / "signals.xml").read_text().replace("UDP_PORT", str(20000 + os.getpid() % 20000))
+    cfg = tmp_path / "signals.xml"
+    cfg.write_text(base)
+    log = open(tmp_path / "ccommd.log", "w")
+    cmd = [str(build_dir / "bin" / "ccommd"), "--config", str(cfg), "--node", "pytest", "--no-rt",
+           "--transport", "udp", "--ptp-socket", "none"]
+    procs: List["subprocess.Popen[bytes]"] = [subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)]
+
+    def restart(old: Optional[str] = None, new: Optional[str] = None) -> None:
+        procs[-1].terminate()
+        procs[-1].wait(timeout=10)
+        if old is not None and new is not None:
+            cfg.write_text(base.replace(old, new))
+        procs.append(subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT))
+
+    try:
+        yield restart
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.terminate()
+                p.wait(timeout=10)
+        log.close()
+        os.environ["CCOMM_SHM_PREFIX"] = saved
+        for name in ("pytest", "pytest.view", "pytest.lock"):
+            seg = Path("/dev/shm") / (prefix.lstrip("/") + name)
+            if seg.exists():
+                seg.unlink()

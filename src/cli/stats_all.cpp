@@ -9,18 +9,12 @@
 #include <string>
 
 #include "ccomm/ccomm.h"
+#include "tools/json_text.h"
 
 namespace {
 
 // JSON string body: names are XML names (no quotes), but escape anyway.
-std::string Json(const char* s) {
-  std::string o;
-  for (; s && *s; ++s) {
-    if (*s == '"' || *s == '\\') o += '\\';
-    if (static_cast<unsigned char>(*s) >= 0x20) o += *s;
-  }
-  return o;
-}
+std::string Json(const char* s) { return ccomm::app::JsonText(s); }
 
 double Ms(int64_t ns) { return ns < 0 ? -1.0 : static_cast<double>(ns) / 1e6; }
 

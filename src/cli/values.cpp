@@ -4,12 +4,11 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
-
-#include <cmath>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <cmath>
 #include <vector>
 
 

@@ -26,6 +26,7 @@
 
 #include "ccomm/ccomm.h"
 #include "tools/app_os.h"
+#include "tools/json_text.h"
 
 namespace {
 
@@ -233,9 +234,8 @@ std::vector<ccomm_signal> Resolve(ccomm_client* c, const std::string& list, bool
   return out;
 }
 
-}  // namespace
-
 // An option's number, the whole word (atof read "abc" as 0 and "5abc" as 5); false if not.
+// Signed (--prio, --cpu): the checks of each option's range follow.
 bool Number(const char* word, double* out) {
   char* end = nullptr;
   double v = strtod(word, &end);
@@ -244,21 +244,8 @@ bool Number(const char* word, double* out) {
   return true;
 }
 
-// The label as a JSON string's contents: quotes, backslashes and control characters escaped.
-std::string JsonEscaped(const std::string& text) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (c < 0x20) {
-      char hex[8];
-      snprintf(hex, sizeof hex, "\\u%04x", c);
-      out += hex;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out;
-}
+}  // namespace
+
 
 int main(int argc, char** argv) {
   Options o;
@@ -412,7 +399,7 @@ int main(int argc, char** argv) {
          ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
          ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu,"
          "\"overruns\":%" PRIu64 ",\"first_k\":%" PRIu64 ",\"last_k\":%" PRIu64 "}\n",
-         JsonEscaped(o.label).c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
+         ccomm::app::JsonText(o.label.c_str()).c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
          s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
          v.empty() ? -1 : v.back(), mean, v.size(), overruns, s.first_k, s.last_k);
   ccomm_close(s.tx_client);

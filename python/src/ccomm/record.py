@@ -206,7 +206,7 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
         code, known, _age, err, ptime = unpack_page(page)
         return (ptime, err, code) if known else (-1, -1, code)
 
-    def initial_status(i: int, sid: int, size: int, seq: int) -> int:
+    def initial_status(sid: int, size: int, seq: int) -> int:
         # The status a read gives now for the value a history cursor starts at (the newest
         # kept): stale when it is older than stale_after_ms. Read into a scratch buffer (a
         # stale read returns the safe value, the history the value itself); fresh if a newer
@@ -270,7 +270,7 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                     hist_info.seq, hist_info.source_time_ns = seq, src
                     status = 0  # each value the history kept was fresh when ccommd stored it
                     if initial:  # ... but one from before the start: as a read says now
-                        status = initial_status(i, sid, size, seq)
+                        status = initial_status(sid, size, seq)
                     out += pack(sid, status, FLAG_INITIAL if initial else 0, seq, recv, src,
                                 lost_so_far[i], *production(sid, hist_info_addr))
                     out += view

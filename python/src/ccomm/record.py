@@ -29,6 +29,7 @@ from typing import Any, Callable, List, Optional, Sequence
 
 from .mcap_io import require_mcap
 from . import _native, _view
+from ._tool_args import fifo_priority
 from ._errors import E_CORRUPT, CcommError, error_text
 from .client import Client, SignalInfo
 from .mcap_io.schema import FLAG_INITIAL, RECORD, WATERMARK_ID
@@ -79,7 +80,7 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                    help="chunk compression (default lz4: about 3x smaller, cheap)")
     p.add_argument("--chunk-size", type=int, default=1 << 20, metavar="BYTES",
                    help="uncompressed chunk size (default 1 MiB; chunks also close every second)")
-    p.add_argument("--priority", type=int, default=0, metavar="N",
+    p.add_argument("--priority", type=fifo_priority, default=0, metavar="N",
                    help="SCHED_FIFO priority of the capture loop (needs CAP_SYS_NICE); below "
                         "ccommd's. Without a history tap a state value replaced before the loop "
                         "reads it is missed (counted as a gap)")

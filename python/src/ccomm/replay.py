@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple
 
 from .mcap_io import require_mcap
 from . import _native
+from ._tool_args import fifo_priority
 from ._errors import E_BUSY, E_FULL, CcommError, error
 from .client import Client, SignalInfo
 
@@ -50,7 +51,7 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p.add_argument("-r", "--rate", type=float, default=1.0,
                    help="speed factor: 2 = twice as fast (default 1: the recorded timing)")
     p.add_argument("--loop", action="store_true", help="start again at the end, until SIGINT/SIGTERM")
-    p.add_argument("--priority", type=int, default=0, metavar="N",
+    p.add_argument("--priority", type=fifo_priority, default=0, metavar="N",
                    help="SCHED_FIFO priority (needs CAP_SYS_NICE): steadier timing")
     p.add_argument("--check", action="store_true",
                    help="check that the recording fits this node and print what would be replayed")

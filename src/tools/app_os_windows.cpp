@@ -38,6 +38,7 @@ int SetFifoPriority(int /*priority*/) {
 }
 
 int PinToCpu(int cpu) {
+  if (cpu < 0 || cpu >= static_cast<int>(8 * sizeof(DWORD_PTR))) return EINVAL;  // one processor group's mask
   return SetThreadAffinityMask(GetCurrentThread(), DWORD_PTR{1} << cpu) ? 0 : EINVAL;
 }
 

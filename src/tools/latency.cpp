@@ -148,7 +148,10 @@ void* Receiver(void* arg) {
     }
   }
   if (s->prio > 0) ccomm::app::SetFifoPriority(s->prio);  // best effort, reported by main
-  if (s->cpu >= 0) ccomm::app::PinToCpu(s->cpu);
+  if (s->cpu >= 0) {
+    const int err = ccomm::app::PinToCpu(s->cpu);  // before the loop: a message is fine here
+    if (err != 0) fprintf(stderr, "ccomm-latency: cannot pin the receive thread to CPU %d (%s)\n", s->cpu, strerror(err));
+  }
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
@@ -280,7 +283,13 @@ int main(int argc, char** argv) {
       case 'F': o.samples_file = optarg; break;
       case 'G': o.stages_file = optarg; break;
       case 'X': o.spin = true; break;
-      case 'C': o.cpu = static_cast<int>(v); break;
+      case 'C':
+        if (v < 0 || v > 1023 || v != static_cast<int>(v)) {
+          fprintf(stderr, "ccomm-latency: --cpu %s: expected a CPU number 0..1023\n", optarg);
+          return 2;
+        }
+        o.cpu = static_cast<int>(v);
+        break;
       case 'h': fputs(kUsage, stdout); return 0;
       default: fputs(kUsage, stderr); return 2;
     }

@@ -112,13 +112,17 @@ def test_latency_checks_its_options_and_prints_valid_json(tmp_path):
             return run(pair.exec_prefix("control") + [os.path.join(BIN, "ccomm-latency"), "--node", "control"]
                        + base + list(args), check=False, env=pair.env, timeout=timeout)
         for args in (("-r", "5abc", "-d", "0.2"), ("-d", "abc"), ("--warmup", "zz", "-d", "0.2"),
-                     ("--prio", "x", "-d", "0.2"), ("-d", "1e8")):
+                     ("--prio", "x", "-d", "0.2"), ("-d", "1e8"), ("--cpu", "-1", "-d", "0.2"),
+                     ("--cpu", "1.5", "-d", "0.2")):
             r = latency(*args)
             assert r.returncode == 2 and r.stdout == "", (args, r.returncode, r.stdout, r.stderr)
         t0 = time.time()
         r = latency("-d", "20", "--samples", str(tmp_path / "no-such-dir" / "s.txt"))
         assert r.returncode == 1 and "cannot write" in r.stderr, r
         assert time.time() - t0 < 15  # refused at the start, not after the 20 s run
+        # A CPU the machine lacks: said, not silently ignored (the run goes on unpinned).
+        r = latency("-d", "0.2", "--cpu", "1023")
+        assert r.returncode == 0 and "cannot pin the receive thread to CPU 1023" in r.stderr, r
         r = latency("-d", "0.2", "--label", 'say "hi"\\ \t')
         assert r.returncode == 0, r
         assert json.loads(r.stdout)["label"] == 'say "hi"\\ \t'

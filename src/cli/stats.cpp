@@ -176,14 +176,9 @@ int CmdStatsAll(ccomm_client* c, bool json, double watch);  // stats_all.cpp
 
 namespace {
 // A ccommd restarted with another configuration retires the segment: its counters stay
-// frozen where they were, so --watch stops and says so (ccomm(1), EXIT STATUS 1).
-bool Retired(ccomm_client* c) {
-  ccomm_signal_desc d;
-  if (ccomm_signal_count(c) <= 0 || ccomm_describe(c, 0, &d) != 0) return false;
-  std::vector<uint8_t> value(d.value_bytes);
-  ccomm_info info;
-  return ccomm_read(c, 0, value.data(), value.size(), &info) == CCOMM_E_RETIRED;
-}
+// frozen where they were, so --watch stops and says so (ccomm(1), EXIT STATUS 1). The
+// library's wait reports the retirement (also for a node without signals).
+bool Retired(ccomm_client* c) { return ccomm_wait(c, 0) == CCOMM_E_RETIRED; }
 }  // namespace
 
 int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {

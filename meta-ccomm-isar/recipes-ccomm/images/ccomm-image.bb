@@ -19,12 +19,19 @@ IMAGE_INSTALL += "ccommd"
 # The QEMU boards also run the latency floor programs (qemu-tests/cases/60-latency.sh).
 IMAGE_INSTALL:append:qemuarm = " ccomm-bench"
 # From Debian. The QEMU suite's tools: iproute2, procps, socat, ping, kmod.
-IMAGE_PREINSTALL += "systemd systemd-sysv busybox linuxptp kmod iproute2 procps socat iputils-ping"
+IMAGE_PREINSTALL += "systemd systemd-sysv busybox linuxptp kmod iproute2 procps socat iputils-ping openssh-server"
 
-# root logs in on the serial console with the password "ccomm" (change it on first login)
+# As the image from Debian's tools (meta-ccomm/image-debian/customize): root has no
+# password and must set one at the first login (on the serial console); SSH takes keys
+# only. No password that works over the network, none published.
 USERS += "root"
-USER_root[password] = "ccomm"
-USER_root[flags] = "clear-text-password"
+USER_root[password] = ""
+USER_root[flags] = "allow-empty-password force-passwd-change"
+ROOTFS_POSTPROCESS_COMMAND += "ccomm_sshd_keys_only"
+ccomm_sshd_keys_only() {
+    sudo install -D -m 644 '${CCOMM_TOPDIR}/meta-ccomm/image-debian/rootfs/etc/ssh/sshd_config.d/ccomm.conf' \
+        '${ROOTFSDIR}/etc/ssh/sshd_config.d/ccomm.conf'
+}
 
 # RaMstix: the Overo's U-Boot loads /boot/zImage and /boot/<fdtfile> from the root
 # partition (docs/yocto.md): copies of Debian's kernel and device trees under those names

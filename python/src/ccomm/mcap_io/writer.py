@@ -115,8 +115,8 @@ class RecordingWriter:
                 name, data, topic = ros2_profile.schema_and_channel(d)
                 if name not in schemas:
                     schemas[name] = w.register_schema(name, ros2_profile.SCHEMA_ENCODING, data)
-                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name],
-                                                        channel_metadata(d))
+                meta = dict(channel_metadata(d), offered_qos_profiles=ros2_profile.offered_qos_profiles(d))
+                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name], meta)
                 continue
             name = schema_name(d)
             if name not in schemas:

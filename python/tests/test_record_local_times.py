@@ -5,6 +5,8 @@
   value written during the pass has age 0, so its receive time came out as t, before its
   own source time on the same clock (29 of 5291 messages, up to 456 us). Every value
   written on the recording node must have receive_time_ns >= source_time_ns.
+  With --profile ros2 (no receive time field): the log time (receive) was before the
+  publish time (the write, same node) in 115 messages; never now.
 - ccomm-replay waited up to 10 ms, once per signal, for ccommd to send a signal no other
   node consumes (its `tx` never moves): the pytest node's signals are all such."""
 from __future__ import annotations
@@ -28,11 +30,11 @@ def _env() -> dict:
     return dict(os.environ, PYTHONPATH=src + os.pathsep + os.environ.get("PYTHONPATH", ""))
 
 
-def _record(client: object, node: str, out: Path) -> None:
+def _record(client: object, node: str, out: Path, *extra: str) -> None:
     """Records SIGNALS while writing them round-robin every ~20 us for 1.5 s: writes land
     at every point of the recorder's passes, also between its clock read and its reads."""
     recorder = subprocess.Popen([sys.executable, "-m", "ccomm.record", "-n", node, "-s", ",".join(SIGNALS),
-                                 "-d", "3", "-q", "-o", str(out)], env=_env())
+                                 "-d", "3", "-q", "-o", str(out), *extra], env=_env())
     time.sleep(1.0)  # the recorder attaches
     sigs = [client[name] for name in SIGNALS]  # type: ignore[index]
     end = time.monotonic() + 1.5
@@ -64,6 +66,20 @@ def test_local_receive_time_never_before_source_time(client: object, node: str, 
                 worst = max(worst, m["source_time_ns"] - m["receive_time_ns"])
     assert n > 1000, n
     assert before == 0, f"{before} of {n} values received before they were written (up to {worst / 1e3:.0f} us)"
+
+
+def test_ros2_profile_log_time_never_before_publish_time(client: object, node: str, tmp_path: Path) -> None:
+    from mcap.reader import make_reader
+
+    rec = tmp_path / "local-ros2.mcap"
+    _record(client, node, rec, "--profile", "ros2")
+    n, before = 0, 0
+    with open(rec, "rb") as f:
+        for _schema, _channel, message in make_reader(f).iter_messages(log_time_order=False):
+            n += 1
+            before += message.log_time < message.publish_time  # receive before the write
+    assert n > 1000, n
+    assert before == 0, f"{before} of {n} messages logged (received) before they were published (written)"
 
 
 def test_replay_of_signals_nobody_forwards_does_not_stall(client: object, node: str, tmp_path: Path) -> None:

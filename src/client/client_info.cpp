@@ -72,6 +72,7 @@ static int FillDescription(const ccomm_client* c, ccomm_signal s, ccomm_signal_d
   out->is_event = (d.flags & st::kSigEvent) ? 1 : 0;
   out->produced_here = (d.flags & st::kSigProducedHere) ? 1 : 0;
   out->consumed_here = (d.flags & st::kSigConsumedHere) ? 1 : 0;
+  out->forwarded = (d.flags & st::kSigForwarded) ? 1 : 0;
   out->stale_after_ms = d.stale_after_ms;
   out->producer = d.producer < seg.node_count() ? seg.node_name(d.producer) : "";
   return 0;
@@ -84,7 +85,8 @@ int ccomm_describe_sized(const ccomm_client* c, ccomm_signal s, ccomm_signal_des
 
 // The plain symbols (parenthesised: ccomm.h makes the names macros of the *_sized calls).
 int(ccomm_describe)(const ccomm_client* c, ccomm_signal s, ccomm_signal_desc* out) {
-  return ccomm_describe_sized(c, s, out, sizeof(ccomm_signal_desc));
+  // the layout programs built before `forwarded` was appended pass
+  return ccomm_describe_sized(c, s, out, ccomm::client::FirstSize<ccomm_signal_desc>::value);
 }
 
 int ccomm_parse_element(int32_t type, const char* text, void* out) {

@@ -70,6 +70,11 @@ TEST_F(ClientTest, OpenFindDescribe) {
   EXPECT_EQ(d.value_bytes, 12u);
   EXPECT_EQ(d.produced_here, 1);
   EXPECT_STREQ(d.producer, "a");
+  EXPECT_EQ(d.forwarded, 0);  // no other node consumes it: ccommd never sends it
+  ASSERT_EQ(ccomm_describe(c, ccomm_find(c, "pos"), &d), 0);
+  EXPECT_EQ(d.forwarded, 1);  // consumed by b
+  ASSERT_EQ(ccomm_describe(c, ccomm_find(c, "local"), &d), 0);
+  EXPECT_EQ(d.forwarded, 0);  // consumed by a, its producer, only
   EXPECT_EQ(ccomm_find(c, "missing"), CCOMM_E_NOENT);
   ccomm_close(c);
   ccomm_client* none = nullptr;

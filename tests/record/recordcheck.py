@@ -147,7 +147,9 @@ def check_ros2(path: str, config: str, node: str) -> int:
     """A --profile ros2 recording, read by an independent ROS 2 reader (mcap-ros2-support,
     pinned): profile ros2, every channel a std_msgs type (ros2msg) on /ccomm/SIGNAL with
     CDR messages that decode; ccomm-latency's values (k = 1, 2, ... in every double `node`
-    produces) equal the message's sequence number, in order."""
+    produces) equal the message's sequence number, in order; every channel has the
+    profile's required offered_qos_profiles, a YAML list of one reliable, volatile profile."""
+    import yaml
     from mcap_ros2.decoder import DecoderFactory
     names = set(produced_by(config, node))
     per_topic = defaultdict(list)
@@ -155,6 +157,14 @@ def check_ros2(path: str, config: str, node: str) -> int:
     with open(path, "rb") as f:
         r = make_reader(f, decoder_factories=[DecoderFactory()])
         profile = r.get_header().profile
+        for channel in r.get_summary().channels.values():
+            try:
+                q = yaml.safe_load(channel.metadata.get("offered_qos_profiles", ""))
+                ok = isinstance(q, list) and len(q) == 1 and q[0]["reliability"] == 1 and q[0]["durability"] == 2
+            except (yaml.YAMLError, KeyError, TypeError):
+                ok = False
+            if not ok:
+                bad.append((channel.topic, "offered_qos_profiles", channel.metadata.get("offered_qos_profiles")))
         for schema, channel, message, decoded in r.iter_decoded_messages(log_time_order=False):
             if schema.encoding != "ros2msg" or channel.message_encoding != "cdr" or \
                     not schema.name.startswith("std_msgs/msg/") or not channel.topic.startswith("/ccomm/"):

@@ -13,7 +13,10 @@ import { FoxgloveProbe } from "./foxglove_probe.mjs";
 
 const env = (k) => { if (!process.env[k]) throw new Error("missing environment " + k); return process.env[k]; };
 const WEB_URL = env("WEB_URL"), WS_URL = env("WS_URL"), NODE = env("CCOMM_NODE");
-const WRITER_RATE = 50, WRITER_COUNT = 600;  // 12 s of tick = 1..600
+// 12 s of tick = 1..1200 at 100 Hz: at the default --max-rate a 100 Hz signal must arrive
+// within the documented lag (issue 39: the passes locked onto its writes, p50 5.2 ms)
+const WRITER_RATE = 100, WRITER_COUNT = 1200;
+const LAG_P50_MS = 2;  // docs/integrations/liveview.md: 1-2 ms behind the node
 
 let passed = 0, failed = 0, n = 0;
 async function check(name, fn) {
@@ -74,7 +77,7 @@ const canvasPixels = (page, signal) => page.evaluate((s) =>
 const probe = new FoxgloveProbe(WS_URL);
 let browser, page, browser2, page2;
 const requests = [];
-const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "unused_sp", "mode_request"];  // topic = signal name
+const topics = ["wheel_pos", "tick", "drive_ok", "joint_pos", "count64", "unused_sp", "mode_request"];  // topic = signal name
 
 await check("protocol client: every signal advertised as a JSON channel with a jsonschema", async () => {
   await probe.connect();
@@ -130,9 +133,9 @@ await check("page loads in headless Chromium, from the server only (no other ori
 await check("page connects over the Foxglove protocol, lists every signal, plots the ticked ones", async () => {
   await until(() => page.evaluate(() => document.querySelector("#conn").textContent === "connected"), 10000, "#conn connected");
   const rows = await page.evaluate(() => [...document.querySelectorAll("#signals tbody tr")].map((tr) => tr.dataset.signal));
-  assert(rows.length === 6, "rows: " + rows);
+  assert(rows.length === 7, "rows: " + rows);
   const charts = () => page.evaluate(() => [...document.querySelectorAll(".chart")].map((c) => c.dataset.signal).join(","));
-  assert((await charts()) === rows.join(","), "charts at first (--plot default: all 6): " + (await charts()));
+  assert((await charts()) === rows.join(","), "charts at first (--plot default: all 7): " + (await charts()));
   await page.click('#signals tr[data-signal="tick"] input');  // untick: its plot goes
   assert(!(await charts()).split(",").includes("tick"), "tick still plotted: " + (await charts()));
   await page.click('#signals tr[data-signal="tick"] input');
@@ -172,6 +175,29 @@ await check("the age column: production age ± its error when known (a value of 
   const synced = await page.evaluate(() => window.ccommView.ageCell(
     { age_ns: 1e6, production_age_ns: 41.2e6, production_error_ns: 2000, age_code: "synced" }));
   assert(synced.text === "41.2 ms ±2.0 µs" && !synced.local, JSON.stringify(synced));
+});
+
+await check("numbers as the page shows them: 6 significant digits, the exponent whole (1.5e-10 was 1.50000e-1)", async () => {
+  const shown = await page.evaluate(() => [1.5e-10, 1e-100, 1.5e300, 200000.1, 0.1, 3.14159265, -2.5, 1.0000001e-7, 7]
+    .map((v) => window.ccommView.formatValue(v)));
+  const want = ["1.5e-10", "1e-100", "1.5e+300", "200000", "0.1", "3.14159", "-2.5", "1e-7", "7"];
+  assert(JSON.stringify(shown) === JSON.stringify(want), "formatValue: " + JSON.stringify(shown) + " != " + JSON.stringify(want));
+  pub("wheel_pos", 1.5e-10);
+  await until(async () => (await domRow(page, "wheel_pos")).value === "1.5e-10", 5000, "wheel_pos 1.5e-10 in the table");
+  pub("wheel_pos", -2.5);
+  await until(async () => (await domRow(page, "wheel_pos")).value === "-2.5", 5000, "wheel_pos -2.5 again");
+});
+
+await check("int64 beyond 2^53 exact: a decimal string to the protocol client, shown digit for digit (was ...992)", async () => {
+  const c64 = JSON.parse(probe.channels.get("count64").schema).properties.value;
+  assert(c64.type[0] === "string" && c64.pattern === "^-?[0-9]+$", "int64 value schema: a decimal string " + JSON.stringify(c64));
+  pub("count64", "9007199254744991");
+  const m = await probe.waitFor("count64", (m) => m.value === "9007199254744991", 3000, "count64 as the string 9007199254744991");
+  assert(m.status === "fresh" && typeof m.value === "string", JSON.stringify(m));
+  await until(async () => (await domRow(page, "count64")).value === "9007199254744991", 5000, "count64 exact in the table");
+  pub("count64", "-9223372036854775808");
+  await probe.waitFor("count64", (m) => m.value === "-9223372036854775808", 3000, "count64 at INT64_MIN");
+  await until(async () => (await domRow(page, "count64")).value === "-9223372036854775808", 5000, "INT64_MIN in the table");
 });
 
 await check("a signal that is not written goes stale: badge and protocol message say so", async () => {
@@ -267,7 +293,6 @@ await check("bad HTTP requests: 404 outside the page's files, 400 for junk, page
 
 await check("the protocol client lost nothing while the browser died (every new value, every event)", async () => {
   const code = await writerDone;
-  const webCpuShare = (webCpu() - cpu0) / ((Date.now() - wall0) / 1000);
   assert(code === 0 && writerOut.includes("writer: done " + WRITER_COUNT), "writer exit " + code + ": " + writerOut);
   await probe.waitFor("tick", (m) => m.value === WRITER_COUNT, 3000, "the last tick");
   await sleep(300);
@@ -282,22 +307,29 @@ await check("the protocol client lost nothing while the browser died (every new 
   const row = await domRow(page2, "tick");
   assert(Number(row.skipped) >= 0 && row.value === String(WRITER_COUNT), "page 2 tick row " + JSON.stringify(row));
   console.log(`  # tick: ${WRITER_COUNT} written at ${WRITER_RATE} Hz, ${c1 - c0} sampled and published, all received`);
+  const events = probe.received("mode_request").map((m) => m.msg.value);
+  const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
+  assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
+  assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));
+});
+
+await check(`a ${WRITER_RATE} Hz signal at the default --max-rate: p50 write -> protocol client within ${LAG_P50_MS} ms`, async () => {
+  await writerDone;
+  const webCpuShare = (webCpu() - cpu0) / ((Date.now() - wall0) / 1000);
   // Write-to-client latency of each new value (same host, same clock), for the docs.
   const firsts = new Map();
   for (const m of probe.received("tick")) if (m.msg.seq > seq0 && !firsts.has(m.msg.seq)) firsts.set(m.msg.seq, m);
   const lat = [...firsts.values()].map((m) => Number(m.mono - BigInt(m.msg.source_time_ns)) / 1e6).sort((a, b) => a - b);
+  assert(lat.length > WRITER_COUNT / 2, `${lat.length} tick values received of ${WRITER_COUNT}`);
   const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))].toFixed(2);
   console.log(`  # write -> protocol client latency (ms): min ${q(0)} p50 ${q(0.5)} p99 ${q(0.99)} max ${q(1)} (n=${lat.length})`);
   assert((await floorDone) === 0, "floor reader failed: " + floorOut);
   const f = JSON.parse(floorOut);
   console.log(`  # floor, a libccomm reader of the same values (ms): p50 ${f.p50_ms} p99 ${f.p99_ms} (n=${f.n}); ` +
               `ccomm-web p50 / floor p50 = ${(Number(q(0.5)) / f.p50_ms).toFixed(1)}`);
-  console.log(`  # CPU while the writer ran: ccomm-web ${(100 * webCpuShare).toFixed(1)} % of one CPU (6 signals, 2-3 clients), ` +
+  console.log(`  # CPU while the writer ran: ccomm-web ${(100 * webCpuShare).toFixed(1)} % of one CPU (7 signals, 2-3 clients), ` +
               `floor reader ${(100 * f.cpu).toFixed(1)} % (1 signal); ratio ${(webCpuShare / f.cpu).toFixed(1)}`);
-  const events = probe.received("mode_request").map((m) => m.msg.value);
-  const want = Array.from({ length: WRITER_COUNT / 25 }, (_, i) => i + 1);
-  assert(JSON.stringify(events) === JSON.stringify(want), "events " + JSON.stringify(events));
-  assert(probe.errors.length === 0, "probe errors: " + probe.errors.join("; "));
+  assert(Number(q(0.5)) <= LAG_P50_MS, `p50 ${q(0.5)} ms > ${LAG_P50_MS} ms`);
 });
 
 await check("a page opened after the last event shows that event, not \"never\"", async () => {

@@ -132,3 +132,31 @@ def test_arrays_come_as_lists(client):
     client.write("joint_pos", np.array([0.25, -1.0, 2.0]))
     s.poll()
     assert sent[-1][1]["value"] == [0.25, -1.0, 2.0]
+
+
+def test_int64_exact_as_decimal_string(client):
+    # 2^53 + 3103: a JSON number is read back as ...992 by JavaScript (issue 39)
+    infos = {i.name: i for i in client.signals()}
+    schema = json_schema(infos["count64"])["properties"]["value"]
+    assert schema["type"] == ["string", "null"] and schema["pattern"] == "^-?[0-9]+$", schema
+    s, sent = sampler(client, ["count64"])
+    for v in (9007199254744991, -9223372036854775808, 9223372036854775807):
+        client.write("count64", v)
+        s.poll()
+        assert sent[-1][1]["value"] == str(v), sent[-1][1]
+    assert json_schema(infos["tick"])["properties"]["value"]["type"] == ["integer", "null"]  # int32 stays a number
+
+
+def test_min_interval_holds_a_change_until_due_then_sends_the_newest(client):
+    s, sent = sampler(client, ["tick"])
+    s.min_interval = 0.005
+    client.write("tick", 1)
+    t0 = time.monotonic()
+    assert s.poll(t0) == 1 and s.next_due is None
+    client.write("tick", 2)
+    assert s.poll(t0 + 0.002) == 0 and s.next_due == pytest.approx(t0 + 0.005)  # held back, due then
+    client.write("tick", 3)
+    assert s.poll(t0 + 0.005) == 1 and s.next_due is None
+    assert sent[-1][1]["value"] == 3 and sent[-1][1]["gap"] == 1  # 2 was replaced: counted
+    client.write("tick", 4)
+    assert s.poll(t0 + 0.011) == 1 and sent[-1][1]["value"] == 4  # slower than the limit: at once

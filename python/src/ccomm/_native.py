@@ -102,6 +102,7 @@ class SignalDesc(ctypes.Structure):
         ("stale_after_ms", ctypes.c_uint32),
         ("producer", ctypes.c_char_p),
         ("consumed_here", ctypes.c_int32),
+        ("forwarded", ctypes.c_int32),
     ]
 
 

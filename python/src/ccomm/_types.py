@@ -83,6 +83,7 @@ class SignalInfo:
     stale_after_ms: int  #: 0 = never stale
     producer: str
     consumed_here: bool = False  #: produced elsewhere and delivered to this node
+    forwarded: bool = False  #: produced here and consumed by another node (ccommd sends it)
 
     @property
     def dtype(self) -> "np.dtype[Any]":

@@ -316,7 +316,7 @@ class Client:
                           count=int(d.count), value_bytes=int(d.value_bytes),
                           is_event=bool(d.is_event), produced_here=bool(d.produced_here),
                           stale_after_ms=int(d.stale_after_ms), producer=(d.producer or b"").decode(),
-                          consumed_here=bool(d.consumed_here))
+                          consumed_here=bool(d.consumed_here), forwarded=bool(d.forwarded))
 
     def signals(self) -> List[SignalInfo]:
         """Every signal of the system, in configuration order."""

@@ -220,9 +220,10 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
     bufs = [(ctypes.c_ubyte * d.value_bytes)() for d in sigs]
     # A history cursor per received state when the node keeps history (from the newest
     # value kept: what polling would have read first), else None.
-    # (index, id, buffer address, size, buffer view, is event, history cursor address or 0)
+    # (index, id, buffer address, size, buffer view, is event, history cursor address or 0,
+    # produced on this node)
     items = [(i, d.id, ctypes.addressof(b), d.value_bytes, memoryview(b).cast("B"), d.is_event,
-              ctypes.addressof(cur) if cur is not None else 0)
+              ctypes.addressof(cur) if cur is not None else 0, d.produced_here)
              for i, (d, b, cur) in enumerate(zip(sigs, bufs, cursors))]
     last_seq = [0] * len(sigs)
     first = [True] * len(sigs)  # no value of the signal read yet
@@ -242,8 +243,8 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
     while not stop:
         wait(handle, 100)
         t = now()
-        set_time(handle, t)  # ages against t: the arrival time is t - age, exactly
-        for i, sid, addr, size, view, event, cursor in items:
+        set_time(handle, t)  # ages against t: the arrival time is t - age, exactly, if before t
+        for i, sid, addr, size, view, event, cursor, local in items:
             if cursor:  # every value ccommd stored, in order (see last_overrun above)
                 while True:
                     r = history_read(handle, sid, cursor, addr, size, hinfo_addr)
@@ -286,10 +287,16 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                 status, flags, seq, age, src, lost = unpack_info(info)
                 if seq != last_seq[i]:
                     last_seq[i] = seq
+                    # The library stamps a value's arrival; a read gives its age against t,
+                    # 0 for one that arrived after t (during this pass). A value written on
+                    # this node arrived when it was written: its source time, exactly. One
+                    # received that arrived during the pass: between t and now, so now
+                    # (never before its arrival, at most the pass late).
+                    recv = src if local else (t - age if age > 0 else now())
                     initial = False
                     if not event and first[i]:  # a state's value already there at the start
                         first[i] = False
-                        initial = t - age < start
+                        initial = recv < start
                         if initial:
                             flags |= FLAG_INITIAL
                     if not initial:  # a value from before the start did not wait for the capture
@@ -297,7 +304,7 @@ def capture(c: Client, sigs: List[SignalInfo], cursors: List[Any], fd: int, dura
                             delay.max_ns = age
                         if age >= 1_000_000:
                             delay.over_1ms += 1
-                    out += pack(sid, status, flags, seq, t - age, src, lost, *production(sid, info_addr))
+                    out += pack(sid, status, flags, seq, recv, src, lost, *production(sid, info_addr))
                     out += view
                 if not event:
                     break

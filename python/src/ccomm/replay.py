@@ -135,7 +135,10 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
         get_stats(handle, sid, stats_addr, stats_size)
         return int(stats.tx)
 
-    no_tx: "set[int]" = set()  # signals ccommd did not send within the bound (not forwarded): no probe
+    # No probe for a signal ccommd never sends: one no other node consumes (its tx never
+    # moves: each of its steps waited out the 10 ms bound), nor one it did not send within
+    # the bound.
+    no_tx: "set[int]" = {d.id for d in c.signals() if not d.forwarded}
 
     def flush(hd: int) -> None:
         if probe[0] >= 0:

@@ -114,10 +114,11 @@ CCOMM_API int ccomm_type_from_name(const char* name);
  * sizeof(*out)): the library fills that many bytes and zeroes any it has no field for, so
  * a program keeps working against a newer library (and a newer one against an older).
  * The plain symbols stay for programs built before: ccomm_get_signal_stats fills the
- * 0.1.0 layout (80 bytes), the others the layout of this header, which they had then.
+ * 0.1.0 layout (80 bytes), ccomm_describe the layout without `forwarded`, the others the
+ * layout of this header, which they had then.
  * ccomm_info, ccomm_history_cursor and ccomm_history_info are fixed: the real-time calls
- * take no size. CCOMM_E_INVAL if `size` is smaller than the struct in this header (the
- * first layout the *_sized calls had).
+ * take no size. CCOMM_E_INVAL if `size` is smaller than the first layout the *_sized
+ * calls had (a struct of this header without its appended members).
  */
 
 /** Static description of a signal. */
@@ -131,6 +132,8 @@ typedef struct ccomm_signal_desc {
   uint32_t stale_after_ms; /**< 0 = never stale */
   const char* producer;    /**< producer node name */
   int32_t consumed_here;   /**< 1 if produced elsewhere and delivered to this node */
+  int32_t forwarded;       /**< 1 if produced here and consumed by another node (ccommd sends
+                                it); 0 for a signal only this node uses. Appended */
 } ccomm_signal_desc;
 
 /**

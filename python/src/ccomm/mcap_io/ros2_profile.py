@@ -14,7 +14,14 @@ An array has layout.dim = [{label: SIGNAL, size: n, stride: n}], data_offset 0. 
 std_msgs has no field for is kept in the MCAP record: log time = receive time, publish
 time = source time (both Unix time, as in the json profile), sequence = the low 32 bits
 of seq. Freshness, loss and gaps are not in these messages: record with the default
-profile when those matter (and for ccomm-replay, which reads that one)."""
+profile when those matter (and for ccomm-replay, which reads that one).
+
+Each channel carries `offered_qos_profiles` (the profile's one required channel
+metadata; `ros2 bag play` offers the QoS it names): a YAML list of one profile, the QoS
+ccomm-ros2's writer offers for the signal (docs/integrations/ros2.md, QoS): reliable,
+volatile, a state keep-last 1 with a deadline of stale_after_ms (none: infinite), an
+event keep-all. Written in rosbag2's integer form (the rmw enum values, bag format 8 and
+before), which every rosbag2 reads (later ones detect it)."""
 from __future__ import annotations
 
 import struct
@@ -66,6 +73,30 @@ def definition(desc: SignalInfo) -> bytes:
     element = "uint8" if desc.type == SignalType.BOOL else primitive
     return ("MultiArrayLayout layout\n" + element + "[] data\n" +
             _SEPARATOR + _LAYOUT + _SEPARATOR + _DIMENSION).encode()
+
+
+# rmw's enum values (rmw/types.h) and its infinite duration, as rosbag2 writes them
+_KEEP_LAST, _KEEP_ALL = 1, 2
+_RELIABLE = 1
+_VOLATILE = 2
+_AUTOMATIC = 1
+_INFINITE = (9223372036, 854775807)  # RMW_DURATION_INFINITE: (sec, nsec)
+
+
+def offered_qos_profiles(desc: SignalInfo) -> str:
+    """The channel's offered_qos_profiles: the QoS ccomm-ros2's writer of the signal offers,
+    as rosbag2 serializes a list of profiles (YAML, its key order, no final newline)."""
+    history, depth = (_KEEP_ALL, 0) if desc.is_event else (_KEEP_LAST, 1)
+    ms = desc.stale_after_ms if not desc.is_event else 0
+    deadline = divmod(ms * 1_000_000, 1_000_000_000) if ms > 0 else _INFINITE
+
+    def duration(key: str, d: Tuple[int, int]) -> str:
+        return f"  {key}:\n    sec: {d[0]}\n    nsec: {d[1]}\n"
+
+    return (f"- history: {history}\n  depth: {depth}\n  reliability: {_RELIABLE}\n  durability: {_VOLATILE}\n" +
+            duration("deadline", deadline) + duration("lifespan", _INFINITE) +
+            f"  liveliness: {_AUTOMATIC}\n" + duration("liveliness_lease_duration", _INFINITE) +
+            "  avoid_ros_namespace_conventions: false")
 
 
 def _align(n: int, a: int) -> int:

@@ -24,9 +24,10 @@ from mcap.writer import CompressionType, Writer
 
 from ..client import SignalInfo
 from . import ros2_profile
-from .schema import (FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD, SCHEMA_ENCODING,
-                     WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
+from .schema import (AGE_CODES, FLAG_INITIAL, FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, RECORD,
+                     SCHEMA_ENCODING, WATERMARK_ID, channel_metadata, json_schema, message_encoder, schema_name)
 
+SAME_NODE = AGE_CODES.index("same_node")  #: age code of a value written on the recording node
 HOLD_MIN_NS = 20_000_000  #: messages held behind the capture's watermark, at least
 HOLD_MAX_NS = 2_000_000_000  #: and at most (memory: 2 s of every signal)
 
@@ -115,8 +116,8 @@ class RecordingWriter:
                 name, data, topic = ros2_profile.schema_and_channel(d)
                 if name not in schemas:
                     schemas[name] = w.register_schema(name, ros2_profile.SCHEMA_ENCODING, data)
-                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name],
-                                                        channel_metadata(d))
+                meta = dict(channel_metadata(d), offered_qos_profiles=ros2_profile.offered_qos_profiles(d))
+                self.channel[d.id] = w.register_channel(topic, ros2_profile.MESSAGE_ENCODING, schemas[name], meta)
                 continue
             name = schema_name(d)
             if name not in schemas:
@@ -194,6 +195,12 @@ class RecordingWriter:
                 self.hold_ns = min(HOLD_MAX_NS, max(self.hold_ns, 2 * (self.watermark - log_time)))
             # publish time: the production on the common time base, else the arrival here
             publish_time = prod if prod >= 0 else recv + offset
+            if code == SAME_NODE and prod >= 0 and not flags & FLAG_INITIAL:
+                # written on this node: its arrival is the write, one instant; logged at
+                # the production time too (recv + offset, the start's clock offset, can
+                # differ from it by the realtime clock's slew since: then a log time
+                # before the publish time, a receive before the write)
+                log_time = publish_time
             heapq.heappush(held, (log_time, self.order, channel[sid], data, publish_time, seq & 0xFFFFFFFF))
             self.order += 1
             pos += head + size

@@ -24,9 +24,11 @@ Serves two things until stopped (Ctrl-C, SIGTERM):
 """
 
 EPILOG = """\
-A state signal is published when it changes (at most --max-rate times a second: faster
-signals are sampled, their seq shows the gaps) or its status changes, and at least every
---keepalive seconds; every event of an event signal is published once.
+A state signal is published when it changes or its status changes (at most --max-rate
+messages a second per signal: a signal written faster is sampled, its seq and gap show
+what was skipped; one slower than that arrives as soon as the next pass, within 1 ms of
+the write on an idle machine), and at least every --keepalive seconds; every event of an
+event signal is published once. An int64 value is a decimal string (exact beyond 2^53).
 
 Assets: the page needs uPlot, installed with npm from this package's package.json:
   npm ci --prefix DIR   (DIR holding a copy of ccomm/web/package.json and package-lock.json)
@@ -52,7 +54,9 @@ def parse_args(argv: Optional[List[str]]) -> argparse.Namespace:
     p.add_argument("--http-port", type=int, default=8080, metavar="N", help="page port (default 8080; 0: any)")
     p.add_argument("--plot", metavar="A,B,...", help="comma-separated signals the page plots at first "
                    "(default: the first 8 served; the page can change it)")
-    p.add_argument("--max-rate", type=float, default=100.0, metavar="HZ", help="samples per second at most (default 100)")
+    p.add_argument("--max-rate", type=float, default=200.0, metavar="HZ",
+                   help="messages per second and signal at most (default 200: a signal written at up to "
+                        "about that rate is published on each write, a faster one is sampled)")
     p.add_argument("--keepalive", type=float, default=1.0, metavar="S",
                    help="republish an unchanged signal after this many seconds (default 1)")
     p.add_argument("--assets", metavar="DIR", help="directory with node_modules/uplot (default: see below)")

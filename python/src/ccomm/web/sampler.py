@@ -16,9 +16,16 @@ the local age_ns is known), status "never" (nothing received yet; value 0, times
 null). `gap` counts the values this view did not see between two of its messages: a
 signal written faster than the sampling is sampled (`lost` is ccomm's loss counter).
 
+An int64 value (and each element of an int64 array) is a decimal string ("value":
+"9007199254744991"): exact, where a JSON number above 2^53 is rounded by JavaScript's and
+most other JSON readers. The schema says so (type string, a pattern of digits).
+
 A state signal is published when its sequence number or status changes, and at least
-every `keepalive` seconds (its age and a stale transition stay visible without writes).
-Every event of an event signal is published once (this reader has its own cursor)."""
+every `keepalive` seconds (its age and a stale transition stay visible without writes);
+with `min_interval` (ccomm-web --max-rate) a change that comes sooner than that after
+the signal's previous message waits until then (`next_due` says when: the caller's next
+pass), and a newer value may replace it (counted in `gap`). Every event of an event
+signal is published once (this reader has its own cursor)."""
 from __future__ import annotations
 
 import time
@@ -29,7 +36,7 @@ import numpy as np
 
 from .. import _view
 from .._errors import CcommError
-from ..client import Client, Reading, Signal, SignalInfo, Status
+from ..client import Client, Reading, Signal, SignalInfo, SignalType, Status
 from ..mcap_io.schema import AGE_CODES
 
 _STATUS_NAMES = {Status.FRESH: "fresh", Status.STALE: "stale", Status.NEVER: "never"}
@@ -44,6 +51,9 @@ def topic_of(name: str) -> str:
 def json_schema(info: SignalInfo) -> Dict[str, Any]:
     """JSON schema of the messages of one signal's channel."""
     value: Dict[str, Any] = {"type": [info.type.json_type, "null"]}
+    if info.type == SignalType.INT64:  # exact as text (message_of)
+        value = {"type": ["string", "null"], "pattern": "^-?[0-9]+$",
+                 "description": "int64 as a decimal string: exact (a JSON number above 2^53 is rounded)"}
     if info.count != 1:
         value = {"type": "array", "items": value, "minItems": info.count, "maxItems": info.count}
     integer, nullable = {"type": "integer"}, {"type": ["integer", "null"]}
@@ -74,15 +84,17 @@ def json_schema(info: SignalInfo) -> Dict[str, Any]:
     }
 
 
-def message_of(reading: Reading, now_ns: int, gap: int = 0, production: Optional[Any] = None) -> Dict[str, Any]:
+def message_of(reading: Reading, now_ns: int, gap: int = 0, production: Optional[Any] = None,
+               exact_text: bool = False) -> Dict[str, Any]:
     """The JSON message of one read (not EMPTY) made at CLOCK_MONOTONIC `now_ns`, with its
     production age (`production`: a _native.ProductionAge for that read; None: unknown,
-    no_summary). NaN and infinities become null: JSON has no spelling for them."""
+    no_summary). NaN and infinities become null: JSON has no spelling for them.
+    `exact_text` (int64 signals): the value's integers as decimal strings."""
     value: Any = reading.value
     if isinstance(value, np.ndarray):
-        value = [_finite(v) for v in value.tolist()]
+        value = [str(v) for v in value.tolist()] if exact_text else [_finite(v) for v in value.tolist()]
     else:
-        value = _finite(value)
+        value = str(int(value)) if exact_text and value is not None else _finite(value)
     never = reading.status == Status.NEVER
     return {"value": value, "seq": reading.seq,
             "source_time_ns": None if never else reading.source_time_ns,
@@ -127,6 +139,8 @@ class Sampler:
     names: List[str]
     publish: Callable[[str, Dict[str, Any]], None]
     keepalive: float = 1.0
+    min_interval: float = 0.0  #: seconds between two messages of a state at least (0: none)
+    next_due: Optional[float] = None  #: when a change held back by min_interval is due (monotonic s)
     _tracked: List[_Tracked] = field(default_factory=list)
     _now_ns: int = 0
 
@@ -165,6 +179,7 @@ class Sampler:
             self._ages.follow(now)  # a restarted ccommd's new view
         self._now_ns = self.client.now()  # receive times: one clock reading per pass
         sent = 0
+        self.next_due = None
         for t in self._tracked:
             if t.signal.info.is_event:
                 # Every queued event once; bounded so one flooded queue cannot starve the rest.
@@ -176,7 +191,12 @@ class Sampler:
                     sent += 1
                 continue
             r = t.signal.read()
-            if r.seq != t.last_seq or r.status != t.last_status or now - t.last_sent >= self.keepalive:
+            changed = r.seq != t.last_seq or r.status != t.last_status
+            if changed and now - t.last_sent < self.min_interval - 1e-6:  # (1 us: float rounding of a due time)
+                due = t.last_sent + self.min_interval  # sent then (or its newer value)
+                if self.next_due is None or due < self.next_due:
+                    self.next_due = due
+            elif changed or now - t.last_sent >= self.keepalive:
                 self._send(t, r, now)
                 sent += 1
         return sent
@@ -191,4 +211,4 @@ class Sampler:
         pa = None
         if self._ages is not None:
             pa = self._ages.of(t.signal.info.id, r.seq, r.source_time_ns)
-        self.publish(t.signal.name, message_of(r, self._now_ns, gap, pa))
+        self.publish(t.signal.name, message_of(r, self._now_ns, gap, pa, t.signal.info.type == SignalType.INT64))

@@ -32,6 +32,7 @@ VENDOR_FILES = {
     "uPlot.min.css": ("uplot/dist/uPlot.min.css", "text/css"),
 }
 DAEMON_STATUS_ID = "ccommd"
+PASS_PERIOD = 0.001  #: s: sampling passes at most 1000 a second
 _STATIC_TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript", ".css": "text/css"}
 
 
@@ -160,19 +161,28 @@ class LiveServer:
         self.last[name] = {"log_time_ns": now, "message": message}  # one dict store: atomic
 
     def _sample_loop(self) -> None:
-        """Wakes on any change of the node (ccomm_wait) or every 100 ms (a value going stale
-        changes nothing in memory), at most max_rate times a second."""
-        min_period = 1.0 / self.max_rate
+        """Wakes on any change of the node (ccomm_wait), when a change held back by
+        --max-rate is due, or every 100 ms (a value going stale changes nothing in memory).
+        --max-rate limits each signal's messages (Sampler.min_interval), not the passes: a
+        limit on the passes at a signal's own rate made the passes lock onto its writes
+        out of phase (a 100 Hz signal at the 100 Hz default arrived 5 ms late at p50).
+        Passes are at most one per PASS_PERIOD (the CPU bound), so a write during a pass
+        waits that long at most."""
+        min_period = min(PASS_PERIOD, 1.0 / self.max_rate)
         while not self.stop_event.is_set():
             try:
                 with Client(self.node) as client:
-                    sampler = Sampler(client, [i.name for i in self.infos], self._publish, self.keepalive)
+                    sampler = Sampler(client, [i.name for i in self.infos], self._publish, self.keepalive,
+                                      min_interval=1.0 / self.max_rate)
                     try:
                         base, base_changes, base_gaps = dict(self.published), dict(self.changes), dict(self.gaps)
                         while not self.stop_event.is_set():
+                            timeout = 0.1
+                            if sampler.next_due is not None:
+                                timeout = max(0.0, min(timeout, sampler.next_due - time.monotonic()))
+                            client.wait(timeout=timeout)
                             started = time.monotonic()
-                            client.wait(timeout=0.1)
-                            sampler.poll()
+                            sampler.poll(started)
                             self._watch_daemon(client.daemon_alive)
                             for name, n in sampler.published.items():
                                 self.published[name] = base[name] + n

@@ -33,12 +33,23 @@ function setConn(state) {
   view.connected = state === "connected";
 }
 
+// Six significant digits, trailing zeros of the fraction dropped: 1.5e-10 -> "1.5e-10",
+// 0.1 -> "0.1", 200000.1 -> "200000". Only the mantissa's fraction is trimmed (trimming
+// the whole text turned 1.5e-10 into "1.50000e-1" and 200000.1 into "2").
+function formatNumber(v) {
+  const [mantissa, exponent] = v.toPrecision(6).split("e");
+  const m = mantissa.includes(".") ? mantissa.replace(/\.?0+$/, "") : mantissa;
+  return exponent === undefined ? m : m + "e" + exponent;
+}
+
+// int64 values come as decimal strings (exact beyond 2^53): shown as they are.
 function formatValue(v) {
   if (v === null || v === undefined) return "–";
   if (Array.isArray(v)) return "[" + v.map(formatValue).join(", ") + "]";
-  if (typeof v === "number" && !Number.isInteger(v)) return v.toPrecision(6).replace(/\.?0+$/, "");
+  if (typeof v === "number" && !Number.isInteger(v)) return formatNumber(v);
   return String(v);
 }
+view.formatValue = formatValue;
 
 function formatAge(ns) {
   if (ns === null || ns === undefined) return "–";
@@ -176,7 +187,9 @@ function buildCharts() {
 function addPoint(name, tSeconds, value, status) {
   const c = view.charts[name];
   if (!c) return;
-  const values = (Array.isArray(value) ? value : [value]).map((v) => (typeof v === "boolean" ? Number(v) : v));
+  // bool as 0/1; an int64's decimal string as the nearest double (a plot needs no more)
+  const values = (Array.isArray(value) ? value : [value]).map((v) =>
+    (typeof v === "boolean" || typeof v === "string" ? Number(v) : v));
   c.data[0].push(tSeconds);
   const nValues = c.data.length - 1 - (c.staleSeries ? 1 : 0);
   for (let i = 1; i <= nValues; i++) c.data[i].push(values[i - 1] === undefined ? null : values[i - 1]);

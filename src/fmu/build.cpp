@@ -83,12 +83,17 @@ bool Spawn(const std::vector<std::string>& args, const char* dir, std::string* o
   return false;
 }
 
-// The FMI platform directory for the compiler's target triple; nullptr if unknown.
-const char* TargetPlatform(const std::vector<std::string>& cc, int major) {
+// The FMI platform directory for the compiler's target triple; nullptr if unknown, with
+// what the compiler said (or why it did not run) in *why.
+const char* TargetPlatform(const std::vector<std::string>& cc, int major, std::string* why) {
   std::vector<std::string> args = cc;
   args.push_back("-dumpmachine");
   std::string out;
-  if (!Spawn(args, nullptr, &out)) return nullptr;
+  if (!Spawn(args, nullptr, &out, why)) {
+    *why += out.empty() ? "" : ": " + out;
+    return nullptr;
+  }
+  *why = "target " + out;
   const std::string triple = out;
   if (triple.rfind("x86_64-", 0) == 0) return major == 3 ? "x86_64-linux" : "linux64";
   if (triple.rfind("aarch64-", 0) == 0) return major == 3 ? "aarch64-linux" : "linux64";
@@ -149,9 +154,12 @@ int BuildSourceFmu(const std::string& fmu_path, int argc, char** argv) {
     std::fputs("ccomm-fmu build: the compiler (--cc or $CC) is empty\n", stderr);
     return 1;
   }
-  const char* platform = TargetPlatform(cc_words, md.fmi_major);
+  std::string cc_target;
+  const char* platform = TargetPlatform(cc_words, md.fmi_major, &cc_target);
   if (platform == nullptr) {
-    std::fprintf(stderr, "ccomm-fmu build: cannot tell the target of compiler '%s' (-dumpmachine)\n", cc.c_str());
+    while (!cc_target.empty() && cc_target.back() == '\n') cc_target.pop_back();
+    std::fprintf(stderr, "ccomm-fmu build: cannot tell the target of compiler '%s' (-dumpmachine: %s)\n",
+                 cc.c_str(), cc_target.c_str());
     return 1;
   }
   const std::string bin_dir = dir + "/binaries/" + platform;

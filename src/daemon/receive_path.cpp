@@ -31,6 +31,8 @@ void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind 
   peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
   const uint32_t n = segment_.signal_count(), m = static_cast<uint32_t>(cfg.nodes.size());
   peers_rx_.assign(m, PeerRx());
+  // A floor no frame bears out stands one heartbeat interval at most (peer_clock.h).
+  for (PeerRx& pr : peers_rx_) pr.clock.set_confirm_window_ns(uint64_t{cfg.network.heartbeat_ms} * 1000000);
   replay_.assign(m, auth::ReplayWindow());
   for (uint32_t p = 0; p < m; ++p) {
     // UDP frames must come from the peer's own address (rule 2); raw frames carry no

@@ -4,6 +4,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include <string>
+
 #include "common/platform.h"
 
 namespace ccomm {
@@ -41,6 +43,16 @@ void Log(LogLevel level, const char* fmt, ...) {
   vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
   va_end(ap);
   fprintf(g_log_file ? g_log_file : stderr, "%s\n", line);
+}
+
+void LogText(LogLevel level, const std::string& text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    size_t j = text.find('\n', i);
+    if (j == std::string::npos) j = text.size();
+    if (j > i) Log(level, "%.*s", static_cast<int>(j - i), text.c_str() + i);
+    i = j + 1;
+  }
 }
 
 }  // namespace ccomm

@@ -150,3 +150,18 @@ def test_no_node_error_priority_3_and_the_wait_ends_on_the_hostname():
         for seg in os.listdir("/dev/shm"):
             if seg.startswith(f"ccq-fb{os.getpid()}."):
                 os.unlink(os.path.join("/dev/shm", seg))
+
+
+def test_a_long_fatal_error_is_whole():
+    """A "no node" message naming 64 nodes is longer than a log line buffer: it must reach
+    the journal whole (its advice is at the end), with its priority."""
+    with tempfile.TemporaryDirectory() as d:
+        nodes = "\n".join(f'  <node name="a_rather_long_node_name_{i:02d}" ip="10.9.{i}.1" transport="udp"/>'
+                          for i in range(64))
+        cfg = write(d, "many.xml", f'<?xml version="1.0"?>\n<ccomm version="1">\n{nodes}\n</ccomm>\n')
+        env = dict(os.environ, JOURNAL_STREAM="8:1234")
+        r = in_namespace(f"{CCOMMD} --which-node --config {cfg} || echo \"EXIT $?\"", env=env)
+        assert "EXIT 1" in r.stdout, r.stdout + r.stderr
+        line = [l for l in r.stderr.splitlines() if "no node of" in l]
+        assert len(line) == 1 and line[0].startswith("<3>ccommd: no node of"), r.stderr
+        assert len(line[0]) > 1024 and line[0].endswith("give the node this board's mac= or ip="), line[0][-200:]

@@ -269,6 +269,7 @@ int RunDaemon(int argc, char** argv) {
   }
   if (board_net) {
 #ifdef _WIN32
+    (void)dry_run, (void)network_dir_given;
     Log(LogLevel::kError, "ccommd: --board-net configures a Linux board's network; not on Windows");
     return 2;
 #else

@@ -64,20 +64,28 @@ def test_board_net_by_mac_sets_hostname_link_and_address():
 
 
 def test_board_net_kernel_cmdline_wins_and_no_ip_means_dhcp():
-    # /proc/cmdline cannot be faked here: --node stands for the explicit choice (it comes
-    # before ccomm.node=, which board_net_test covers); the MAC names the other board.
+    # /proc/cmdline of this namespace: a file bound over it (own mount namespace).
     with tempfile.TemporaryDirectory() as d:
         cfg = write(d, "signals.xml", CONFIG.format(port=47891, ip1="10.42.0.1", ip2="", transport="raw"))
-        r = in_namespace(f"""
+        cmdline = write(d, "cmdline", "console=ttyAMA0 net.ifnames=0 ccomm.node=planner root=/dev/vda rw\n")
+        r = subprocess.run(["unshare", "--mount", "--propagation", "private", "--net", "--uts", "bash", "-c", f"""
+            set -e
+            hostname localhost
+            mount --bind {cmdline} /proc/cmdline
             ip link add eth0 type veth peer name veth1
             ip link set eth0 address 52:54:00:42:00:01
-            {CCOMMD} --config {cfg} --board-net --dry-run --node planner
+            {CCOMMD} --config {cfg} --board-net --dry-run
             echo "HOST $(hostname)"
-            """)
+            {CCOMMD} --config {cfg} --board-net --dry-run --node control >/dev/null
+            """], capture_output=True, text=True, timeout=40)
         assert r.returncode == 0, r.stdout + r.stderr
-        assert "this board is node 'planner' (--node): hostname planner, interface eth0, DHCP" in r.stderr, r.stderr
+        # ccomm.node= beats the MAC (control's); the node has no ip=: DHCP.
+        assert ("this board is node 'planner' (ccomm.node= on the kernel command line): hostname planner, "
+                "interface eth0, DHCP") in r.stderr, r.stderr
         assert "DHCP=ipv4" in r.stdout and "Address=" not in r.stdout, r.stdout
         assert "HOST localhost" in r.stdout, "--dry-run changed the hostname: " + r.stdout
+        # --node (or CCOMM_NODE, /etc/default/ccommd) beats the command line.
+        assert "this board is node 'control' (--node)" in r.stderr, r.stderr
 
 
 def test_board_net_no_node_is_an_error_at_priority_3():

@@ -3,7 +3,7 @@
 # qemu-tests: reinstalling the image's own ccommd package (dpkg -i, as an upgrade does) while
 # qemu-tests: values flow: ccommd is running afterwards (try-restart on the new binary, no
 # qemu-tests: stop left behind), the values flow again, and the gap is measured.
-# qemu-tests: timeout=300
+# qemu-tests: timeout=420
 . "$(dirname "$0")/../lib/common.sh"
 need_ccomm
 
@@ -18,7 +18,7 @@ check "before: $B reads $sig fresh" arrives_fresh $B "$sig" 3.5 15
 vm_bg $B mon "ccomm echo $sig --interval 20" >/dev/null
 sleep 2
 before=$(vm $B 'systemctl show -p MainPID --value ccommd')
-out=$(vm --timeout 240 $B "DEBIAN_FRONTEND=noninteractive dpkg -i $deb 2>&1; echo rc=\$?")
+out=$(vm --timeout 300 $B "DEBIAN_FRONTEND=noninteractive dpkg -i $deb 2>&1; echo rc=\$?")
 tail -n 4 <<<"$out" | sed 's/^/  dpkg: /'
 check "dpkg -i $(basename "$deb") (a reinstall) succeeds" grep -qx 'rc=0' <<<"$out"
 after=$(vm $B 'systemctl is-active ccommd; systemctl show -p MainPID --value ccommd')

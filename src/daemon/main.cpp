@@ -163,6 +163,7 @@ int RunDaemon(int argc, char** argv) {
   bool network_dir_given = false;
   // Under systemd every line gets its priority, also a usage error's (journalctl -p err).
   SetLogPrefixes(getenv("JOURNAL_STREAM") != nullptr);
+  opterr = 0;
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
     switch (ch) {
@@ -199,7 +200,11 @@ int RunDaemon(int argc, char** argv) {
       case 'h': fputs(kUsage, stdout); return 0;
       case 'V': printf("ccommd %s (wire v%u, shm layout v%u)\n", CCOMM_VERSION, unsigned{wire::kVersion},
                        store::kLayoutVersion); return 0;
-      default: fputs(kUsage, stderr); return 2;
+      default:
+        // getopt's own message would go out without a priority (opterr = 0 above).
+        Log(LogLevel::kError, "ccommd: unknown option or missing argument: '%s'", argv[optind - 1]);
+        fputs(kUsage, stderr);
+        return 2;
     }
   }
   if (json && !opt.check_only) {

@@ -119,6 +119,11 @@ def test_fatal_config_errors_carry_priority_3():
         located = [l for l in lines if re.match(r"^<3>" + re.escape(bad) + r":\d+:", l)]
         assert len(located) >= 2, "FILE:LINE errors without <3>:\n" + r.stderr
         assert all(l.startswith("<") for l in lines), "a line without a priority prefix:\n" + r.stderr
+        # A usage error (a bad CCOMMD_OPTS) too, not getopt's unprefixed message.
+        r = subprocess.run([CCOMMD, "--config", bad, "--no-such-option"], capture_output=True, text=True, env=env,
+                           timeout=20)
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.startswith("<3>ccommd: unknown option or missing argument: '--no-such-option'"), r.stderr
         # Without journald (a terminal) the lines stay as they were, no prefix.
         r = subprocess.run([CCOMMD, "--check", bad], capture_output=True, text=True, timeout=20,
                            env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"})

@@ -3,7 +3,8 @@
 # U-Boot (MLO + u-boot.img), under an Overo's factory U-Boot in NAND, and under any
 # distro-boot U-Boot (devtype/devnum/distro_bootpart set by it; else mmc 0, partition 1).
 # Kernel, initramfs and device tree come from the root partition (partition 2): /boot/zImage,
-# Debian's /initrd.img link, /boot/${fdtfile}.
+# Debian's /initrd.img link (its kernel has the MMC host and ext4 as modules; a root file
+# system without /initrd.img, as Yocto's, boots without one), /boot/${fdtfile}.
 #
 # Overrides: uEnv.txt on the FAT partition, imported when present (name=value lines):
 #   fdtfile      Linux device tree in /boot of partition 2. Default by SoC: the Overo Fire
@@ -50,7 +51,7 @@ if test "${ccomm_fdt}" = "firmware"; then
 		setenv ccomm_ok 0
 	fi
 	setenv ccomm_dt ${fdt_addr}
-	setenv ccomm_dtname "the firmware's device tree at ${fdt_addr}"
+	setenv ccomm_dtname "device tree of the firmware at ${fdt_addr}"
 else
 	if test -z "${ccomm_console}"; then setenv ccomm_console ttyO2,115200n8; fi
 	if test -e ${devtype} ${devnum}:2 /boot/${fdtfile}; then
@@ -67,9 +68,12 @@ if test -n "${ccomm_console}"; then setenv ccomm_conarg console=${ccomm_console}
 if test "${ccomm_ok}" = "1"; then
 	setenv bootargs "${ccomm_conarg} root=${ccomm_root} rw rootfstype=ext4 rootwait cpufreq.default_governor=performance ${optargs}"
 	echo "ccomm: kernel /boot/zImage, ${ccomm_dtname}, root ${ccomm_root}"
-	load ${devtype} ${devnum}:2 ${ramdisk_addr_r} /initrd.img
-	setenv ccomm_rdsize ${filesize}
+	setenv ccomm_rd -
+	if test -e ${devtype} ${devnum}:2 /initrd.img; then
+		load ${devtype} ${devnum}:2 ${ramdisk_addr_r} /initrd.img
+		setenv ccomm_rd ${ramdisk_addr_r}:${filesize}
+	fi
 	load ${devtype} ${devnum}:2 ${kernel_addr_r} /boot/zImage
-	bootz ${kernel_addr_r} ${ramdisk_addr_r}:${ccomm_rdsize} ${ccomm_dt}
+	bootz ${kernel_addr_r} ${ccomm_rd} ${ccomm_dt}
 	echo "ccomm: bootz failed"
 fi

@@ -23,7 +23,15 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
   idle_sleep_ns_ = watchdog_ns && watchdog_ns / 4 < heartbeat_ns_ ? watchdog_ns / 4 : heartbeat_ns_;
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   const bool multicast = table_.multicast();
+  // A reload (same nodes): each stream's frame numbers go on where they were, so the
+  // peers count no loss and see no restart.
+  std::vector<uint32_t> seqs;
+  if (peers_tx_.size() == m + 1)
+    for (const PeerTx& p : peers_tx_) seqs.push_back(p.seq);
   peers_tx_ = std::vector<PeerTx>(m + 1);  // + the group stream
+  for (size_t p = 0; p < seqs.size(); ++p) peers_tx_[p].seq = seqs[p];
+  periodic_.clear();
+  senders_.clear();
   group_tx_ = static_cast<uint32_t>(m);
   consumers_.assign(n, {});
   for (size_t i = 0; i < n; ++i) {

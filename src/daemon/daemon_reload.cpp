@@ -100,8 +100,8 @@ int Daemon::Reconfigure(const SystemConfig& next, uint32_t node_id, std::string*
   if (r != 0) return r;
   table_.Resolve(segment_, auth_.enabled());
   supervisor_.Prepare(adopted_, /*reload=*/true);
-  send_.Prepare(adopted_);
   const bool same_shape = adopted_ && old_nodes == next.nodes.size() && old_signals == next.signals.size();
+  send_.Prepare(adopted_, same_shape);
   receive_.Prepare(next, node_id, kind, opt_.recv_timeout_ms, same_shape);
   view_.Stop();
   r = view_.Start(next, node_id, kind, opt_.force_udp, &segment_, &transport_, &auth_, gid_, error);

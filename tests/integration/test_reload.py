@@ -181,6 +181,9 @@ def test_reload_with_a_local_change_keeps_the_segment_and_every_value(tmp_path):
         w, r = _result(writer), _result(reader)
         prod, cons = _all_delivered(pair)
         logs = {n: pair.log(n) for n in ("control", "planner")}
+        # The system view was set up again too: both boards in it, both alive.
+        view = json.loads(pair.cli("planner", "stats", "--all", "--json").stdout)
+        assert view["node"] == "planner", view
         for node in ("control", "planner"):
             assert pair.daemons[node].poll() is None
             assert _segment_inode(pair, node) == inodes[node]

@@ -5,6 +5,7 @@
 // their hot paths, and what they read is handed over by pthread_join / pthread_create.
 // The socket stays open meanwhile (frames that arrive queue in it), so does the segment
 // when its layout is the same.
+#include <stdio.h>
 #include <string.h>
 
 #include <vector>

@@ -85,12 +85,15 @@ struct IoThreads {
   bool running = false;
 };
 
+#ifndef _WIN32
 // SIGUSR2 interrupts an I/O thread's blocking call (the receive thread waits in its socket
 // up to recv_timeout_ms): both loops treat EINTR as "nothing yet" and look at `running`.
 void Interrupted(int) {}
+#endif
 
 int StartIo(ccomm::Daemon& daemon, IoThreads* io) {
   using namespace ccomm;
+#ifndef _WIN32
   static bool handler_installed = false;
   if (!handler_installed) {
     struct sigaction sa = {};
@@ -99,6 +102,7 @@ int StartIo(ccomm::Daemon& daemon, IoThreads* io) {
     sigaction(SIGUSR2, &sa, nullptr);
     handler_installed = true;
   }
+#endif
   if (int e = pthread_create(&io->tx, nullptr, TxThread, &daemon)) {
     Log(LogLevel::kError, "ccommd: cannot start the send thread: %s", strerror(e));
     return e;
@@ -116,6 +120,9 @@ int StartIo(ccomm::Daemon& daemon, IoThreads* io) {
 // Joins `t`, interrupting it every millisecond meanwhile: a signal that came while the
 // thread was between blocking calls would be missed, and one more costs nothing.
 void JoinInterrupting(pthread_t t) {
+#ifdef _WIN32
+  pthread_join(t, nullptr);  // no reload there (stop_request_windows.cpp): a stop may wait
+#else
   for (;;) {
     pthread_kill(t, SIGUSR2);
     struct timespec ts;
@@ -127,6 +134,7 @@ void JoinInterrupting(pthread_t t) {
     }
     if (pthread_timedjoin_np(t, nullptr, &ts) == 0) return;
   }
+#endif
 }
 
 // Stops the I/O threads for a stop or a reload: at once, not after the receive thread's

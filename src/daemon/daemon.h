@@ -3,7 +3,8 @@
 // woken by the shared-memory doorbell or its periodic/heartbeat deadline), a receive part
 // (receive_path.h, the receive thread, blocked in the socket) and supervision
 // (supervisor.h, a tick on the main thread), each owning its state, over one
-// prepared-signals table built in Start() and constant afterwards (prepared_signals.h);
+// prepared-signals table built in Start() and constant while the I/O threads run (a reload
+// builds it again with them stopped: daemon_reload.cpp; prepared_signals.h);
 // what the threads hand each other is in thread_handoffs.h. Daemon owns what they share
 // (the segment, the transport, the frame key, the system view) and starts them.
 // Everything is allocated in Start(); the three loops never allocate (test_alloc.py).

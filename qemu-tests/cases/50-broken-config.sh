@@ -1,7 +1,8 @@
 #!/bin/bash
 # SPDX-License-Identifier: Apache-2.0
 # qemu-tests: a broken /etc/ccomm/signals.xml (an XML syntax error, then a wrong type):
-# qemu-tests: the service refuses to start and the journal names the file and line; the
+# qemu-tests: the service refuses to start and the journal names the file and line, at
+# qemu-tests: error priority (journalctl -p err); the
 # qemu-tests: fixed file starts again and signals flow.
 # qemu-tests: timeout=300
 . "$(dirname "$0")/../lib/common.sh"
@@ -39,6 +40,12 @@ broken_cycle() {
 	journal=$(vm $B "journalctl -u ccommd --since @$since --no-pager -o cat")
 	grep -m 1 "$CFG:" <<<"$journal" | sed "s/^/  journal: /"
 	check "$what: the journal shows $CFG:$line" grep -q "$CFG:$line\\b" <<<"$journal"
+	# At error priority (ccommd(8): each line carries its syslog priority), so that
+	# journalctl -p err, what an operator asks first, shows why the service failed.
+	local errs
+	errs=$(vm $B "journalctl -u ccommd -p err --since @$since --no-pager -o cat")
+	grep -m 1 "$CFG:" <<<"$errs" | sed "s/^/  journal -p err: /"
+	check "$what: journalctl -p err shows $CFG:$line" grep -q "$CFG:$line\\b" <<<"$errs"
 	check "$what: the peer (control) sees planner down" \
 		wait_until 10 eval "vm control 'ccomm stats --json' | jcheck 'not any(p[\"alive\"] for p in d[\"peers\"])'"
 

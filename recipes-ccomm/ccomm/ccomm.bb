@@ -88,7 +88,9 @@ do_install_ptest() {
 
 PACKAGE_BEFORE_PN = "lib${BPN} ${PN}-cli ${PN}-fmu ${PN}-integrations"
 
-SYSTEMD_SERVICE:${PN} = "ccommd.service"
+# ccomm-board-net: the board's hostname and address from signals.xml (ccommd(8)); a
+# Yocto image is a board's, so it is enabled here (the Debian package leaves it off).
+SYSTEMD_SERVICE:${PN} = "ccommd.service ccomm-board-net.service"
 SYSTEMD_AUTO_ENABLE:${PN} = "enable"
 
 # ccommd.service runs as User=ccomm; dist/ccomm.sysusers.conf describes the same account
@@ -102,7 +104,8 @@ FILES:${PN}-cli += "${bindir}/ccomm ${bindir}/ccomm-latency"
 FILES:${PN}-fmu += "${bindir}/ccomm-fmu"
 # 20-sim / Simulink templates and generators (Python scripts)
 FILES:${PN}-integrations += "${datadir}/ccomm/integrations"
-FILES:${PN} += "${systemd_system_unitdir}/ccommd.service ${nonarch_libdir}/sysusers.d/ccomm.conf"
+FILES:${PN} += "${systemd_system_unitdir}/ccommd.service ${systemd_system_unitdir}/ccomm-board-net.service \
+                ${nonarch_libdir}/sysusers.d/ccomm.conf"
 
 CONFFILES:${PN} = "${sysconfdir}/ccomm/signals.xml"
 

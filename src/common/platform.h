@@ -137,6 +137,9 @@ int NamedGroupId(const char* name);
 /// stderr with sd-daemon priority prefixes ("<3>"), which journald understands.
 enum class LogLevel { kError = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
 void Log(LogLevel level, const char* fmt, ...) CCOMM_PRINTF_FORMAT(2, 3);
+/// Log() for each line of `text` (a multi-line message such as the configuration's
+/// FILE:LINE errors): under journald every line then carries `level`.
+void LogText(LogLevel level, const std::string& text);
 void SetLogVerbosity(LogLevel max_level);
 void SetLogPrefixes(bool sd_prefixes);
 /// Appends log lines to the file `path` instead of stderr (a Windows service has no

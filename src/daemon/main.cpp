@@ -9,6 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifndef _WIN32
+#include <sys/stat.h>
+#endif
 
 #include <memory>
 #include <string>
@@ -16,6 +19,7 @@
 #include "common/platform.h"
 #include "config/config.h"
 #include "config/config_json.h"
+#include "daemon/board_net.h"
 #include "daemon/daemon.h"
 #include "daemon/node_identity.h"
 #include "daemon/privileges.h"
@@ -44,6 +48,13 @@ const char kUsage[] =
     "                        hostname if it names a node, else the node whose mac= or ip= is\n"
     "                        on one of this board's interfaces: one image for every board)\n"
     "      --which-node      print which node this board is, and how it was found; exit\n"
+    "      --board-net       at boot, as root (ccomm-board-net.service): find this board's node\n"
+    "                        (--node, $CCOMM_NODE, ccomm.node= on the kernel command line, the\n"
+    "                        interfaces' MAC, the hostname), set the hostname to its name, bring\n"
+    "                        its interface up with its ip= (/24) or DHCP; exit\n"
+    "      --dry-run         with --board-net: say what it would do, change nothing\n"
+    "      --network-dir DIR with --board-net: where the .network file goes (default\n"
+    "                        /run/systemd/network)\n"
     "      --check [FILE]    validate the configuration, print every error as FILE:LINE, exit\n"
     "      --json            with --check: print the resolved configuration as JSON (nodes,\n"
     "                        signals, types, hash, ros2) for tools; docs/config.md\n"
@@ -69,6 +80,64 @@ const char kUsage[] =
     "Signals: SIGTERM/SIGINT stop; SIGHUP reloads the file (docs/usage.md, \"Reload\").\n"
     "Exit status: 0 clean stop or valid config, 1 invalid config, 2 usage, 3 start-up failure.\n"
     "See ccommd(8), docs/config.md and docs/protocol.md.\n";
+
+#ifndef _WIN32
+// --board-net (board_net.h): waits up to 10 s for the node's interface (the network
+// driver may still be probing at boot), then configures it. 0 done, 1 no node / failed.
+int RunBoardNet(const ccomm::SystemConfig& cfg, const std::string& explicit_node, const char* explicit_from,
+                bool dry_run, const std::string& network_dir, bool network_dir_given) {
+  using namespace ccomm;
+  std::string name = explicit_node, from = explicit_from;
+  if (name.empty()) {
+    // /proc/cmdline: one line, size 0 to stat (so not ReadRegularFile).
+    char line[4096] = "";
+    if (FILE* f = fopen("/proc/cmdline", "r")) {
+      if (!fgets(line, sizeof line, f)) line[0] = '\0';
+      fclose(f);
+    }
+    name = KernelCmdlineNode(line);
+    from = "ccomm.node= on the kernel command line";
+  }
+  BoardNetPlan plan;
+  std::string error;
+  const uint64_t t0 = platform::MonotonicNs(), limit_ns = 10ull * 1000 * 1000 * 1000;
+  int r = 0;
+  for (bool said = false;;) {
+    char host[256] = "";
+    if (!platform::HostName(host, sizeof host)) host[0] = '\0';
+    const bool last = platform::MonotonicNs() - t0 >= limit_ns;
+    r = PlanBoardNet(cfg, name, from.c_str(), host, LocalInterfaces(), last, &plan, &error);
+    if (r != 0) break;
+    if (!said) Log(LogLevel::kNotice, "board-net: this board's node or its interface is not there yet; waiting up to 10 s");
+    said = true;
+    platform::SleepNs(100ull * 1000 * 1000);
+  }
+  if (r < 0) {
+    Log(LogLevel::kError, "ccommd --board-net: %s", error.c_str());
+    return 1;
+  }
+  const NodeConfig& node = cfg.nodes[static_cast<size_t>(plan.node)];
+  Log(LogLevel::kNotice, "board-net: this board is node '%s' (%s): hostname %s, interface %s, %s", node.name.c_str(),
+      plan.how.c_str(), node.name.c_str(), plan.interface.empty() ? "none" : plan.interface.c_str(),
+      plan.interface.empty() ? "no address" : plan.address.empty() ? "DHCP" : plan.address.c_str());
+  if (dry_run) {
+    if (!plan.interface.empty()) fputs(BoardNetNetworkFile(cfg, plan).c_str(), stdout);
+    return 0;
+  }
+  // The .network file where systemd runs (networkd then manages the link with the same
+  // settings) or where DHCP needs it; without systemd a static address is enough.
+  std::string dir = network_dir;
+  struct stat st;
+  if (!network_dir_given && !plan.address.empty() && stat("/run/systemd/system", &st) != 0) dir.clear();
+  std::vector<std::string> done;
+  if (ApplyBoardNet(cfg, plan, dir, &done, &error) != 0) {
+    Log(LogLevel::kError, "ccommd --board-net: %s", error.c_str());
+    return 1;
+  }
+  for (const std::string& d : done) Log(LogLevel::kInfo, "board-net: %s", d.c_str());
+  return 0;
+}
+#endif
 
 void* TxThread(void* d) {
   static_cast<ccomm::Daemon*>(d)->RunTx();
@@ -147,17 +216,6 @@ void StopIo(ccomm::Daemon& daemon, IoThreads* io) {
   io->running = false;
 }
 
-// Each line of `text` at error priority (FILE:LINE messages into the journal as errors).
-void LogErrorLines(const std::string& text) {
-  size_t at = 0;
-  while (at < text.size()) {
-    size_t end = text.find('\n', at);
-    if (end == std::string::npos) end = text.size();
-    if (end > at) ccomm::Log(ccomm::LogLevel::kError, "%s", text.substr(at, end - at).c_str());
-    at = end + 1;
-  }
-}
-
 std::string FirstLine(const std::string& text) { return text.substr(0, text.find('\n')); }
 
 enum class ReloadOutcome { kApplied, kRefused, kBroken };
@@ -175,7 +233,7 @@ ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
   auto next = std::unique_ptr<SystemConfig>(new SystemConfig);
   std::string error;
   auto refuse = [&](const std::string& why) {
-    LogErrorLines(why);
+    LogText(LogLevel::kError, why);
     Log(LogLevel::kError, "reload failed: still forwarding on the configuration loaded before (hash %08x)",
         (*cfg)->hash);
     const std::string status = "forwarding on the old configuration; reload failed: " + FirstLine(why);
@@ -235,11 +293,18 @@ int RunDaemon(int argc, char** argv) {
       {"quiet", no_argument, nullptr, 'q'},        {"help", no_argument, nullptr, 'h'},
       {"version", no_argument, nullptr, 'V'},      {"which-node", no_argument, nullptr, 'W'},
       {"json", no_argument, nullptr, 'J'},
+      {"board-net", no_argument, nullptr, 'B'}, {"dry-run", no_argument, nullptr, 'D'},
+      {"network-dir", required_argument, nullptr, 'N'},
       {"ptp-socket", required_argument, nullptr, 'P'}, {"clock-config", no_argument, nullptr, 'K'},
       {"reload", required_argument, nullptr, 'L'},
       {nullptr, 0, nullptr, 0}};
-  bool json = false;
+  bool json = false, board_net = false, dry_run = false;
   int reload_pid = 0;
+  std::string network_dir = "/run/systemd/network";
+  bool network_dir_given = false;
+  // Under systemd every line gets its priority, also a usage error's (journalctl -p err).
+  SetLogPrefixes(getenv("JOURNAL_STREAM") != nullptr);
+  opterr = 0;
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {
     switch (ch) {
@@ -253,7 +318,7 @@ int RunDaemon(int argc, char** argv) {
       case 'T':
         if (strcmp(optarg, "udp") == 0) opt.force_udp = true;
         else if (strcmp(optarg, "raw") != 0) {
-          fprintf(stderr, "ccommd: --transport takes 'udp' or 'raw', not '%s'\n", optarg);
+          Log(LogLevel::kError, "ccommd: --transport takes 'udp' or 'raw', not '%s'", optarg);
           return 2;
         }
         break;
@@ -268,41 +333,60 @@ int RunDaemon(int argc, char** argv) {
       case 'L':
         reload_pid = atoi(optarg);
         if (reload_pid <= 0) {
-          fprintf(stderr, "ccommd: --reload takes the pid of the running ccommd, not '%s'\n", optarg);
+          Log(LogLevel::kError, "ccommd: --reload takes the pid of the running ccommd, not '%s'", optarg);
           return 2;
         }
+        break;
+      case 'B': board_net = true; break;
+      case 'D': dry_run = true; break;
+      case 'N':
+        network_dir = optarg;
+        network_dir_given = true;
         break;
       case 'v': verbosity = verbosity < 7 ? verbosity + 1 : 7; break;
       case 'q': verbosity = 4; break;
       case 'h': fputs(kUsage, stdout); return 0;
       case 'V': printf("ccommd %s (wire v%u, shm layout v%u)\n", CCOMM_VERSION, unsigned{wire::kVersion},
                        store::kLayoutVersion); return 0;
-      default: fputs(kUsage, stderr); return 2;
+      default:
+        // getopt's own message would go out without a priority (opterr = 0 above).
+        Log(LogLevel::kError, "ccommd: unknown option or missing argument: '%s'", argv[optind - 1]);
+        fputs(kUsage, stderr);
+        return 2;
     }
   }
   if (json && !opt.check_only) {
-    fprintf(stderr, "ccommd: --json goes with --check\n");
+    Log(LogLevel::kError, "ccommd: --json goes with --check");
+    return 2;
+  }
+  if (dry_run && !board_net) {
+    Log(LogLevel::kError, "ccommd: --dry-run goes with --board-net");
+    return 2;
+  }
+  if (reload_pid && (board_net || opt.check_only || opt.which_node || opt.clock_config)) {
+    Log(LogLevel::kError, "ccommd: --reload goes with none of --board-net, --check, --which-node, --clock-config");
+    return 2;
+  }
+  if (board_net && (opt.check_only || opt.which_node || opt.clock_config)) {
+    Log(LogLevel::kError, "ccommd: --board-net goes with none of --check, --which-node, --clock-config");
     return 2;
   }
   if (optind < argc) {
-    fprintf(stderr, "ccommd: unexpected argument '%s'\n%s", argv[optind], kUsage);
+    Log(LogLevel::kError, "ccommd: unexpected argument '%s'", argv[optind]);
+    fputs(kUsage, stderr);
     return 2;
   }
   SetLogVerbosity(static_cast<LogLevel>(verbosity));
-  SetLogPrefixes(getenv("JOURNAL_STREAM") != nullptr);
 
   // The configuration in use; a reload replaces it (Reload above).
   std::unique_ptr<SystemConfig> cfg_owner(new SystemConfig);
   SystemConfig& cfg = *cfg_owner;
   std::string error;
   if (!LoadConfig(opt.config_path, &cfg, &error)) {
-    if (reload_pid) {  // ExecReload=: the journal shows these as errors
-      LogErrorLines(error);
+    // Each FILE:LINE line at error priority: these are why the service (or the reload) failed.
+    LogText(LogLevel::kError, error);
+    if (reload_pid)  // ExecReload=
       Log(LogLevel::kError, "not reloaded: ccommd (pid %d) keeps running on the configuration it has", reload_pid);
-      return 1;
-    }
-    fprintf(stderr, "%s", error.c_str());
-    if (!error.empty() && error.back() != '\n') fputc('\n', stderr);
     return 1;
   }
   if (reload_pid) {
@@ -330,7 +414,7 @@ int RunDaemon(int argc, char** argv) {
     for (uint32_t i = 0; i < cfg.nodes.size(); ++i) {
       const std::string fit = SegmentFitProblem(cfg, i, store::SegmentName(cfg.nodes[i].name));
       if (!fit.empty()) {
-        fprintf(stderr, "%s: error: %s\n", opt.config_path.c_str(), fit.c_str());
+        Log(LogLevel::kError, "%s: error: %s", opt.config_path.c_str(), fit.c_str());
         return 3;
       }
     }
@@ -345,7 +429,8 @@ int RunDaemon(int argc, char** argv) {
       const int n = IdentifyNode(cfg, name, "--node", host, LocalInterfaces(), &how, &why);
       if (n >= 0 && cfg.nodes[static_cast<size_t>(n)].transport == TransportKind::kRaw) {
         const NodeConfig& self = cfg.nodes[static_cast<size_t>(n)];
-        fprintf(stderr, "%s:%d: error: %s\n", opt.config_path.c_str(), self.line, RawEthernetUnavailable(self).c_str());
+        Log(LogLevel::kError, "%s:%d: error: %s", opt.config_path.c_str(), self.line,
+            RawEthernetUnavailable(self).c_str());
         return 1;
       }
     }
@@ -358,19 +443,30 @@ int RunDaemon(int argc, char** argv) {
     opt.node = getenv("CCOMM_NODE");
     explicit_from = "$CCOMM_NODE";
   }
+  if (board_net) {
+#ifdef _WIN32
+    (void)dry_run, (void)network_dir_given;
+    Log(LogLevel::kError, "ccommd: --board-net configures a Linux board's network; not on Windows");
+    return 2;
+#else
+    return RunBoardNet(cfg, opt.node, explicit_from.c_str(), dry_run, network_dir, network_dir_given);
+#endif
+  }
   char host[64] = "";
   if (!platform::HostName(host, sizeof host)) host[0] = '\0';
   std::string how, node_error;
   int node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
-  // At boot the board's address may come a little after ccommd starts (DHCP): when the
-  // interfaces were to decide, look again for up to 10 s before giving up.
-  for (int tries = 0; node < 0 && opt.node.empty() && !opt.which_node && tries < 20; ++tries) {
+  // At boot the board's address or hostname may come a little after ccommd starts (DHCP,
+  // ccomm-board-net.service without the ordering): look again every 100 ms, the hostname
+  // too, for up to 10 s, and go on as soon as one names a node.
+  for (int tries = 0; node < 0 && opt.node.empty() && !opt.which_node && tries < 100; ++tries) {
     if (tries == 0) Log(LogLevel::kNotice, "%s; waiting up to 10 s for the board's addresses", node_error.c_str());
-    platform::SleepNs(500ull * 1000 * 1000);
+    platform::SleepNs(100ull * 1000 * 1000);
+    if (!platform::HostName(host, sizeof host)) host[0] = '\0';
     node = IdentifyNode(cfg, opt.node, explicit_from.c_str(), host, LocalInterfaces(), &how, &node_error);
   }
   if (node < 0) {
-    fprintf(stderr, "ccommd: %s\n", node_error.c_str());
+    Log(LogLevel::kError, "ccommd: %s", node_error.c_str());
     return 1;
   }
   if (opt.which_node) {
@@ -380,7 +476,7 @@ int RunDaemon(int argc, char** argv) {
   if (opt.clock_config) {
     const std::string text = Ptp4lConfig(cfg, static_cast<uint32_t>(node), &error);
     if (text.empty()) {
-      fprintf(stderr, "ccommd: %s\n", error.c_str());
+      Log(LogLevel::kError, "ccommd: %s", error.c_str());
       return 1;
     }
     fputs(text.c_str(), stdout);

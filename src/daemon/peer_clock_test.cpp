@@ -69,6 +69,62 @@ TEST(PeerClock, ResetForgetsTheOldClock) {
   EXPECT_EQ(c.Observe(1 * kS + kMs, 1001 * kS + kMs), 0u);
 }
 
+// One forged frame (no key) stamped an hour ahead: x is an hour below the floor. Genuine
+// frames after it read an hour queued (stale, with an age of our uptime) until the window
+// turned over, 2-4 s, and for good while the peer was quiet. Now one heartbeat interval at most.
+TEST(PeerClock, AForgedFutureStampHoldsTheFloorDownOneHeartbeatIntervalAtMost) {
+  constexpr uint64_t kHeartbeat = 100 * kMs, kHour = 3600 * kS;
+  for (const bool quiet : {false, true}) {
+    PeerClock c;
+    c.set_confirm_window_ns(kHeartbeat);
+    uint64_t t = 10 * kS;
+    for (int i = 0; i < 100; ++i, t += 10 * kMs) c.Observe(t, t + 200'000);  // 1 s of normal frames
+    const int64_t floor = c.floor_ns();
+    EXPECT_EQ(c.Observe(t + kHour, t + 200'000), 0u);  // the forged frame
+    const uint64_t forged_at = t + 200'000;
+    if (quiet) t += 60 * kS;  // the peer says nothing for a minute
+    for (int i = 1; i <= 300; ++i) {
+      const uint64_t sent = t + static_cast<uint64_t>(i) * 10 * kMs, arrival = sent + 250'000;
+      const uint64_t d = c.Observe(sent, arrival);
+      if (arrival > forged_at + kHeartbeat) {
+        EXPECT_LT(d, kMs) << (quiet ? "after a quiet minute, " : "") << "frame " << i << " read queued "
+                          << d << " ns, " << (arrival - forged_at) / kMs << " ms after the forged one";
+      }
+    }
+    EXPECT_LT(c.floor_ns() > floor ? c.floor_ns() - floor : floor - c.floor_ns(), static_cast<int64_t>(kMs));
+  }
+}
+
+TEST(PeerClock, AForgedFutureStampAfterAResetIsNotTheFloorForLong) {
+  // A forged frame with a lower seq and a later stamp reads as the peer's restart (rule 5):
+  // the floor is reset and the forged frame is the first of the new clock.
+  constexpr uint64_t kHeartbeat = 100 * kMs;
+  PeerClock c;
+  c.set_confirm_window_ns(kHeartbeat);
+  c.Observe(5 * kS, 5 * kS + 100'000);
+  c.Reset();
+  c.Observe(5 * kS + 3600 * kS, 5 * kS + 200'000);
+  for (int i = 1; i <= 50; ++i) {
+    const uint64_t sent = 5 * kS + static_cast<uint64_t>(i) * 10 * kMs;
+    const uint64_t d = c.Observe(sent, sent + 150'000);
+    if (i * 10 * kMs > kHeartbeat) {
+      EXPECT_LT(d, kMs) << "frame " << i;
+    }
+  }
+}
+
+TEST(PeerClock, AFasterPathIsTakenOnTheSecondFrame) {
+  // The first frames came queued by 50 ms (start-up), then the path is fast: the lower floor
+  // is confirmed by the next frame at once, so a later queued frame is recognised.
+  PeerClock c;
+  for (uint64_t i = 0; i < 5; ++i) c.Observe(i * 10 * kMs, i * 10 * kMs + 50 * kMs);
+  EXPECT_EQ(c.Observe(60 * kMs, 60 * kMs + 100'000), 0u);
+  EXPECT_EQ(c.Observe(70 * kMs, 70 * kMs + 100'000), 0u);
+  EXPECT_EQ(c.Observe(80 * kMs, 80 * kMs + 30 * kMs + 100'000), 30 * kMs);
+  for (uint64_t i = 0; i < 50; ++i) c.Observe(100 * kMs + i * 10 * kMs, 100 * kMs + i * 10 * kMs + 100'000);
+  EXPECT_EQ(c.Observe(700 * kMs, 700 * kMs + 20 * kMs + 100'000), 20 * kMs) << "the fast floor stayed";
+}
+
 constexpr uint16_t kStateId = 1;
 
 class QueuedFrameTest : public testing::ReceivingDaemonTest {
@@ -117,6 +173,26 @@ TEST_F(QueuedFrameTest, AValueFromAQueuedFrameIsAsOldAsItsWait) {
   Send(7, 7, 7.0, platform::MonotonicNs());
   EXPECT_GE(Meta().local_time_ns + 500 * kMs, platform::MonotonicNs());
   EXPECT_EQ(ps.frames_delayed.load(), 1u);
+}
+
+TEST_F(QueuedFrameTest, AForgedFutureStampMakesGenuineValuesStaleOneHeartbeatIntervalAtMost) {
+  for (uint32_t i = 1; i <= 5; ++i) Send(i, i, 1.0 * i, platform::MonotonicNs());
+  // A frame of b, forged (no key is configured): an hour ahead of b's clock.
+  const uint64_t forged_at = platform::MonotonicNs();
+  Send(6, 6, 6.0, forged_at + 3600 * kS);
+  // b's genuine frames every 20 ms for 0.5 s: past one heartbeat interval (100 ms) after the
+  // forged frame, their values arrive fresh again (the age was the host's uptime for 2-4 s).
+  uint32_t seq = 7;
+  for (int i = 0; i < 25; ++i, ++seq) {
+    usleep(20'000);
+    const uint64_t sent = platform::MonotonicNs();
+    Send(seq, seq, 1.0 * seq, sent);
+    if (sent > forged_at + 150 * kMs) {
+      const uint64_t age = platform::MonotonicNs() - Meta().local_time_ns;
+      EXPECT_LT(age, 500 * kMs) << "value " << seq << ", " << (sent - forged_at) / kMs << " ms after the forged frame";
+    }
+  }
+  EXPECT_LT(daemon_.segment().peer(1).queue_delay_ns.load(), 10 * kMs);
 }
 
 }  // namespace

@@ -41,6 +41,8 @@ void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind 
     for (const RxSignal& r : rx_signals_) old_last.push_back(r.last);
   }
   peers_rx_.assign(m, PeerRx());
+  // A floor no frame bears out stands one heartbeat interval at most (peer_clock.h).
+  for (PeerRx& pr : peers_rx_) pr.clock.set_confirm_window_ns(uint64_t{cfg.network.heartbeat_ms} * 1000000);
   replay_.assign(m, auth::ReplayWindow());
   if (keep_sequences) {
     for (uint32_t p = 0; p < m; ++p) {

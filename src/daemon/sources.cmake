@@ -7,7 +7,7 @@ set(CCOMM_DAEMON_SOURCES daemon.cpp daemon_reload.cpp prepared_signals.cpp send_
     send_cycle.cpp send_cycle_daemon.cpp)
 set(CCOMM_DAEMON_POSIX_SOURCES transport_raw.cpp foreign_frames.cpp transport_udp.cpp node_interfaces_posix.cpp
     privileges.cpp auth_key_file_posix.cpp ptp_socket_posix.cpp stop_request_posix.cpp service_none.cpp
-    txtime_socket_posix.cpp)
+    txtime_socket_posix.cpp board_net.cpp board_net_linux.cpp)
 set(CCOMM_DAEMON_WINDOWS_SOURCES raw_ethernet_none.cpp transport_udp_windows.cpp node_interfaces_windows.cpp
     privileges_windows.cpp auth_key_file_windows.cpp ptp_socket_windows.cpp stop_request_windows.cpp
     service_windows.cpp)

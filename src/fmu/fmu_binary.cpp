@@ -69,8 +69,9 @@ bool FmuBinary::Load(const std::string& dir, const ModelDescription& md, std::st
   std::string so = dir + "/binaries/" + PlatformDirectory(major_) + "/" + md.model_identifier + ".so";
   lib_ = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (lib_ == nullptr) {
-    *error = "cannot load " + so + ": " + dlerror() +
-             " (no binary for this platform? a source FMU: ccomm-fmu build)";
+    std::string why = dlerror();
+    if (why.rfind(so + ": ", 0) == 0) why.erase(0, so.size() + 2);  // dlerror names the file again
+    *error = so + ": cannot load: " + why + " (no binary for this platform? a source FMU: ccomm-fmu build)";
     return false;
   }
   error->clear();

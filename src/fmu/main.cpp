@@ -235,9 +235,14 @@ int Main(int argc, char** argv) {
   }
   ModelDescription md;
   const std::string md_path = unpacked.dir() + "/modelDescription.xml";
-  if (!LoadModelDescription(md_path, &md, &error) ||
-      (!schema_dir.empty() && !ValidateSchema(schema_dir, md.fmi_major, md_path, &error))) {
-    std::fprintf(stderr, "ccomm-fmu: %s: %s\n", fmu_path.c_str(), error.c_str());
+  // Messages name the FMU's own file and the member in it (UnpackedFmu::Unpacked), not
+  // the temporary copy, which is gone when they are read.
+  if (!LoadModelDescription(md_path, &md, &error)) {
+    std::fprintf(stderr, "ccomm-fmu: %s\n", unpacked.Unpacked(error).c_str());
+    return 1;
+  }
+  if (!schema_dir.empty() && !ValidateSchema(schema_dir, md.fmi_major, md_path, &error)) {
+    std::fprintf(stderr, "ccomm-fmu: %s: %s\n", fmu_path.c_str(), unpacked.Unpacked(error).c_str());
     return 1;
   }
   std::snprintf(g_crash_name, sizeof g_crash_name, "%s", md.model_name.c_str());
@@ -286,7 +291,7 @@ int Main(int argc, char** argv) {
   }
   FmuBinary binary;
   if (!binary.Load(unpacked.dir(), md, &error)) {
-    std::fprintf(stderr, "ccomm-fmu: %s\n", error.c_str());
+    std::fprintf(stderr, "ccomm-fmu: %s\n", unpacked.Unpacked(error).c_str());
     return 1;
   }
   Runner runner(md, binary, opt);

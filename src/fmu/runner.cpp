@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "runner.h"
 
+#include <fcntl.h>
 #include <ftw.h>
+#include <signal.h>
 #include <sched.h>
 #include <spawn.h>
 #include <sys/mman.h>
@@ -49,7 +51,54 @@ int RemoveEntry(const char* path, const struct stat*, int, FTW*) { return remove
 
 UnpackedFmu::~UnpackedFmu() {
   if (temporary_) nftw(dir_.c_str(), RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
+  if (watcher_fd_ >= 0) close(watcher_fd_);
 }
+
+std::string UnpackedFmu::Shown(const std::string& member) const {
+  return temporary_ ? path_ + ": " + member : dir_ + "/" + member;
+}
+
+std::string UnpackedFmu::Unpacked(std::string text) const {
+  if (!temporary_) return text;
+  const std::string prefix = dir_ + "/";
+  for (size_t at; (at = text.find(prefix)) != std::string::npos;) text.replace(at, prefix.size(), path_ + ": ");
+  return text;
+}
+
+namespace {
+// The watcher: forked before anything else runs (one thread, nothing locked), it holds
+// no descriptor but the pipe's read end, ignores the stop signals (systemd's SIGTERM goes
+// to the whole unit) and waits for end of file: the FMU task has ended, however it did.
+// Then it removes the copy. It costs the task nothing while it runs (a sleeping process).
+int StartWatcher(const std::string& dir) {
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    return -1;
+  }
+  if (pid == 0) {
+    for (int s : {SIGTERM, SIGINT, SIGHUP, SIGALRM}) signal(s, SIG_IGN);
+    dup2(fds[0], 0);
+    close_range(1, ~0U, 0);
+    const int null = open("/dev/null", O_RDWR);  // fds 1 and 2: a log pipe is not held open
+    if (null >= 0) {
+      dup2(null, 1);
+      dup2(null, 2);
+    }
+    setsid();  // not the task's process group: a kill of the task's group leaves it
+    char c;
+    while (read(0, &c, 1) != 0 && errno == EINTR) {
+    }
+    nftw(dir.c_str(), RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
+    _exit(0);
+  }
+  close(fds[0]);
+  return fds[1];
+}
+}  // namespace
 
 bool UnpackedFmu::Open(const std::string& path, std::string* error) {
   struct stat st;
@@ -70,7 +119,9 @@ bool UnpackedFmu::Open(const std::string& path, std::string* error) {
     return false;
   }
   dir_ = templ;
+  path_ = path;
   temporary_ = true;
+  watcher_fd_ = StartWatcher(dir_);
   // An FMU is a zip archive: unzip (busybox has one) keeps this program free of an archive library.
   const char* argv[] = {"unzip", "-q", "-o", path.c_str(), "-d", dir_.c_str(), nullptr};
   pid_t pid;
@@ -229,16 +280,22 @@ int Runner::Retired() {
   return 75;
 }
 
-double Runner::ElementAsDouble(const Binding& b, uint32_t i) {
+uint64_t Runner::RecordCell(const Binding& b, uint32_t i) {
   const uint8_t* p = b.value.data();
+  auto bits = [](double v) { uint64_t u; std::memcpy(&u, &v, 8); return u; };
+  if (b.kind == Kind::kFreshness) return p[0];
   switch (b.var->type) {
-    case FmiType::kFloat64: { double v; std::memcpy(&v, p + 8 * i, 8); return v; }
-    case FmiType::kFloat32: { float v; std::memcpy(&v, p + 4 * i, 4); return v; }
-    case FmiType::kInt32: { int32_t v; std::memcpy(&v, p + 4 * i, 4); return v; }
+    case FmiType::kFloat64: { double v; std::memcpy(&v, p + 8 * i, 8); return bits(v); }
+    case FmiType::kFloat32: { float v; std::memcpy(&v, p + 4 * i, 4); return bits(v); }
+    case FmiType::kInt32: { int32_t v; std::memcpy(&v, p + 4 * i, 4); return static_cast<uint64_t>(int64_t{v}); }
     case FmiType::kUInt32: { uint32_t v; std::memcpy(&v, p + 4 * i, 4); return v; }
-    case FmiType::kInt64: { int64_t v; std::memcpy(&v, p + 8 * i, 8); return static_cast<double>(v); }
+    case FmiType::kInt64: { int64_t v; std::memcpy(&v, p + 8 * i, 8); return static_cast<uint64_t>(v); }
     default: return p[i];
   }
+}
+
+bool Runner::RecordIsInteger(const Binding& b) {
+  return b.kind == Kind::kFreshness || (b.var->type != FmiType::kFloat64 && b.var->type != FmiType::kFloat32);
 }
 
 int Runner::Run(volatile sig_atomic_t* stop) {
@@ -251,7 +308,12 @@ int Runner::Run(volatile sig_atomic_t* stop) {
       return 1;
     }
     if (opt_.cycles <= SIZE_MAX / sizeof(double) / columns)
-      record_.reset(new (std::nothrow) double[opt_.cycles * columns]());
+      record_.reset(new (std::nothrow) uint64_t[opt_.cycles * columns]());
+    record_integer_ = {true, false, true};  // cycle, time, lateness_ns
+    for (const Binding& b : bindings_)
+      record_integer_.insert(record_integer_.end(), b.kind == Kind::kFreshness ? 1 : b.var->count,
+                             RecordIsInteger(b));
+    if (opt_.measure) record_integer_.insert(record_integer_.end(), {true, true});
     if (!record_) {
       std::fprintf(stderr, "ccomm-fmu: --record: cannot hold %" PRIu64 " cycles of %u values in memory: give fewer "
                    "--cycles\n", static_cast<uint64_t>(opt_.cycles), columns);
@@ -338,17 +400,17 @@ int Runner::Run(volatile sig_atomic_t* stop) {
       sum_cycle_ += end - now;
     }
     if (record_) {
-      double* row = &record_[cycle_ * columns];
-      *row++ = static_cast<double>(cycle_);
-      *row++ = t;
-      *row++ = static_cast<double>(late);
+      uint64_t* row = &record_[cycle_ * columns];
+      *row++ = cycle_;
+      std::memcpy(row++, &t, 8);
+      *row++ = static_cast<uint64_t>(late);
       for (const Binding& b : bindings_) {
         const uint32_t n = b.kind == Kind::kFreshness ? 1 : b.var->count;
-        for (uint32_t i = 0; i < n; ++i) *row++ = b.kind == Kind::kFreshness ? b.value[0] : ElementAsDouble(b, i);
+        for (uint32_t i = 0; i < n; ++i) *row++ = RecordCell(b, i);
       }
       if (opt_.measure) {
-        *row++ = static_cast<double>(step_end - step_start);
-        *row++ = static_cast<double>(Now() - now);
+        *row++ = static_cast<uint64_t>(step_end - step_start);
+        *row++ = static_cast<uint64_t>(Now() - now);
       }
     }
     cycle_ = cycle_ + 1;
@@ -389,7 +451,17 @@ void Runner::WriteRecord() const {
   std::fputc('\n', f);
   const uint32_t columns = 3 + record_columns_ + (opt_.measure ? 2 : 0);
   for (uint64_t r = 0; r < cycle_; ++r) {
-    for (uint32_t c = 0; c < columns; ++c) std::fprintf(f, c ? ",%.17g" : "%.17g", record_[r * columns + c]);
+    for (uint32_t c = 0; c < columns; ++c) {
+      const uint64_t cell = record_[r * columns + c];
+      if (c != 0) std::fputc(',', f);
+      if (record_integer_[c]) {
+        std::fprintf(f, "%" PRId64, static_cast<int64_t>(cell));
+      } else {
+        double v;
+        std::memcpy(&v, &cell, 8);
+        std::fprintf(f, "%.17g", v);
+      }
+    }
     std::fputc('\n', f);
   }
   std::fclose(f);

@@ -31,16 +31,24 @@ struct RunOptions {
 };
 
 // The FMU's files: the directory given, or a .fmu unzipped into a private temporary
-// directory that is removed again.
+// directory that is removed again: at exit, and also when the process ends by _exit (a
+// hung or crashed FMU), SIGKILL or anything else, by a small watcher process that removes
+// it once this one is gone.
 class UnpackedFmu {
  public:
   ~UnpackedFmu();
   bool Open(const std::string& path, std::string* error);
   const std::string& dir() const { return dir_; }
+  // How a message names the FMU's file `member` ("binaries/x86_64-linux/m.so"): the FMU's
+  // own path and the member, never the temporary copy, which is gone when it is read.
+  std::string Shown(const std::string& member) const;
+  // `text` (dlerror's, xmllint's) with the temporary directory named as Shown() does.
+  std::string Unpacked(std::string text) const;
 
  private:
-  std::string dir_;
+  std::string dir_, path_;
   bool temporary_ = false;
+  int watcher_fd_ = -1;  // the watcher removes dir_ when this closes (our exit)
 };
 
 // `ccomm-fmu build FMU [--cc CC] [--out FILE]` (build.cpp).
@@ -76,7 +84,10 @@ class Runner {
   int Retired();  // ccommd replaced the segment: exit status 75
   void Report(FILE* out) const;
   void WriteRecord() const;
-  static double ElementAsDouble(const Binding& b, uint32_t i);
+  // One record cell: a double's bits, or an integer (Int64 kept exact: 2^53 + 1 is not a
+  // double), as RecordIsInteger() tells for its column.
+  static uint64_t RecordCell(const Binding& b, uint32_t i);
+  static bool RecordIsInteger(const Binding& b);
 
   const ModelDescription& md_;
   FmuBinary& binary_;
@@ -84,7 +95,8 @@ class Runner {
   ccomm_client* client_ = nullptr;
   std::vector<Binding> bindings_;
   uint32_t record_columns_ = 0;
-  std::unique_ptr<double[]> record_;  // --cycles rows, preallocated
+  std::unique_ptr<uint64_t[]> record_;  // --cycles rows, preallocated (cells: RecordCell)
+  std::vector<bool> record_integer_;     // per column: an integer cell, else a double's bits
   FILE* record_file_ = nullptr;  // --record, opened before the first cycle
   volatile uint64_t cycle_ = 0;
   // Statistics (nanoseconds).

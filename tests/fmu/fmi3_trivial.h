@@ -8,6 +8,18 @@
 
 #include <stdlib.h>
 
+// As the Reference-FMUs' sources do: the functions carry the model's prefix
+// (MODEL_IDENTIFIER_fmi3DoStep), as a source FMU compiled with other code needs, unless
+// the importer builds a shared library and says so with FMI3_OVERRIDE_FUNCTION_PREFIX
+// (FMI 3.0, source code FMUs). ccomm-fmu build must define it, or run finds no fmi3DoStep.
+#ifndef MODEL_IDENTIFIER
+#error "the model's .c defines MODEL_IDENTIFIER before including fmi3_trivial.h"
+#endif
+#ifndef FMI3_OVERRIDE_FUNCTION_PREFIX
+#define FMI3_PASTE_(a, b) a##b
+#define FMI3_PASTE(a, b) FMI3_PASTE_(a, b)
+#define FMI3_FUNCTION_PREFIX FMI3_PASTE(MODEL_IDENTIFIER, _)
+#endif
 #include "fmi3Functions.h"
 
 const char* fmi3GetVersion(void) { return fmi3Version; }

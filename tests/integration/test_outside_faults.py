@@ -8,7 +8,9 @@
 - `ccomm pub` reads values as signals.xml does (1e39 and 1e-50 out of range for a float,
   no '+5'), and takes -inf / -nan as values, not options;
 - a peer's restart is logged as ccommd(8) says ("peer 'X' restarted (frame seq ...");
-- a node summary to a raw node without mac= goes out with dest 0xFFFF (protocol.md)."""
+- a node summary to a raw node without mac= goes out with dest 0xFFFF (protocol.md);
+- one forged frame (no key) stamped an hour ahead makes a peer's genuine values stale for
+  one heartbeat interval at most (issue 39; docs/design.md, "Time")."""
 import os
 import signal
 import socket
@@ -17,7 +19,12 @@ import subprocess
 import time
 import uuid
 
+import sys
+
 from harness import BIN, SANITIZED, NodePair, run, wait_for
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+import wire_vectors  # noqa: E402  (independent encoder of the wire format)
 
 PAIR_UDP = """<?xml version="1.0" encoding="UTF-8"?>
 <ccomm version="1">
@@ -185,3 +192,35 @@ def test_transport_mismatch_is_logged_and_counted(tmp_path):
         assert wait_for(lambda: pair.stats("planner")["peers"][0]["alive"], 10)
         time.sleep(0.5)
         assert foreign(pair, "planner") == 0 and foreign(pair, "control") == 0
+
+
+def test_a_forged_future_stamp_makes_genuine_values_stale_one_heartbeat_interval_at_most(tmp_path):
+    """A frame "from control" (its address, the config's hash, no key needed) stamped an hour
+    ahead: planner read control's genuine values stale, with an age of the host's uptime, for
+    2-4 s (the offset floor's window). Now past one heartbeat interval (50 ms here) they are
+    fresh again."""
+    config = PAIR_UDP.replace('name="speed" type="double"', 'name="speed" type="double" stale_after_ms="100"')
+    with NodePair(config=write(tmp_path, "pair.xml", config)) as pair:
+        pair.start("control")
+        pair.start("planner")
+        assert wait_for(lambda: "peer 'control' up" in pair.log("planner"), 10), pair.log("planner")
+        pair.spawn("control", "pub", "speed", "1.5", "--rate", "200", "--count", "100000")
+        assert wait_for(lambda: pair.echo_once("planner", "speed")[1] == "fresh", 10)
+        config_hash = int(pair.log("planner").split("config hash ")[1].split()[0], 16)
+        now = time.monotonic_ns()  # one host: the namespaces share CLOCK_MONOTONIC
+        forged = wire_vectors.Frame("forged", "ok", sender=0, dest=1, config_hash=config_hash, seq=1,
+                                    time_ns=now + 3600 * 10**9,
+                                    entries=[wire_vectors.Entry(2, "int32", [7], seq=1, time_ns=now)]).data()
+        code = ("import socket,sys; s=socket.socket(socket.AF_INET,socket.SOCK_DGRAM); s.bind(('10.42.0.1',0)); "
+                "s.sendto(bytes.fromhex(sys.argv[1]),('10.42.0.2',47841))")
+        rx0 = pair.stats("planner")["counters"]["frames_rx"]
+        run(pair.exec_prefix("control") + ["python3", "-c", code, forged.hex()])
+        t_forged = time.monotonic()
+        assert wait_for(lambda: pair.stats("planner")["counters"]["frames_rx"] > rx0, 5)
+        time.sleep(0.2)  # past one heartbeat interval (50 ms) and a CLI run
+        stale = []
+        while time.monotonic() - t_forged < 3.0:  # the old floor's window was 2-4 s
+            value, status = pair.echo_once("planner", "speed")
+            if status != "fresh":
+                stale.append("%s %s at %.0f ms" % (value, status, (time.monotonic() - t_forged) * 1000))
+        assert not stale, "control's genuine speed read after the forged frame: %s" % stale[:5]

@@ -19,9 +19,35 @@ check() {  # check "description" command...: counts, and shows the output of a f
 }
 quiet_ok() { "$@" >/dev/null 2>&1; }
 
+# ---- what the maintainer scripts ask of systemd ------------------------------------------
+# No systemd runs in a chroot: deb-systemd-invoke and systemctl are stand-ins that log each
+# call, and /run/systemd/system tells the scripts that systemd is running, so what an
+# install, a reinstall, dpkg-reconfigure and a removal would do to ccommd is on record.
+shim=$T/shim calls=$T/systemd-calls.log
+mkdir -p "$shim" /run/systemd/system
+printf '#!/bin/sh\necho "deb-systemd-invoke $*" >>%s\n' "$calls" >"$shim/deb-systemd-invoke"
+# systemctl: what would act on the running system is only logged; the rest (preset,
+# enable, is-enabled: how the postinst enables ccommd.service) runs offline on the files.
+cat >"$shim/systemctl" <<EOF
+#!/bin/sh
+echo "systemctl \$*" >>$calls
+case " \$* " in *" daemon-reload "*|*" start "*|*" stop "*|*" restart "*|*" try-restart "*|*" reload "*) exit 0 ;; esac
+SYSTEMD_OFFLINE=1 exec /bin/systemctl "\$@"
+EOF
+chmod 755 "$shim/deb-systemd-invoke" "$shim/systemctl"
+# apt runs dpkg with its own PATH (DPkg::Path), so it is given the stand-ins' too.
+shim_path=$shim:/usr/sbin:/usr/bin:/sbin:/bin
+with_shim() { : >"$calls"; PATH=$shim_path "$@"; }
+ccommd_calls() { grep -E 'ccommd\.service' "$calls" | grep -vE 'daemon-reload|is-enabled|enable|unmask|mask' || true; }
+
 # ---- the packages install, offline ------------------------------------------------------
 check "apt install ./*.deb (ccommd libccomm0 libccomm-dev python3-ccomm)" \
-  apt-get install -y -q --no-install-recommends -o Debug::NoLocking=1 "$T"/debs/*.deb
+  with_shim apt-get install -y -q --no-install-recommends -o Debug::NoLocking=1 -o DPkg::Path="$shim_path" "$T"/debs/*.deb
+check "the maintainer scripts ran with the stand-ins (systemctl daemon-reload recorded)" grep -q '^systemctl .*daemon-reload' "$calls"
+check "a first install does not start ccommd (the default signals.xml is to be edited)" \
+  bash -c "! grep -E '(start|restart) .*ccommd' $calls || { cat $calls; false; }"
+check "ccomm-board-net.service shipped, not enabled, not started (a PC keeps its network)" bash -c \
+  "test -f /lib/systemd/system/ccomm-board-net.service && ! test -e /etc/systemd/system/multi-user.target.wants/ccomm-board-net.service && ! grep -E 'start .*ccomm-board-net' $calls"
 for p in ccommd libccomm0 libccomm-dev python3-ccomm; do
   check "$p $CCOMM_VERSION installed" bash -c "dpkg-query -W -f='\${Status} \${Version}' $p | grep -qx 'install ok installed $CCOMM_VERSION'"
 done
@@ -48,6 +74,25 @@ up() {
   cat "$T/ccommd.log"; return 1
 }
 check "ccommd runs node robot (examples/local-only.xml)" up
+
+# ---- upgrades keep a running ccommd running ------------------------------------------------
+# The maintainer scripts must not stop ccommd before an upgrade (preinst) and must restart
+# it after one only if it runs: 'try-restart ccommd.service', never 'stop' or 'start'.
+upgrade_keeps_running() {  # checks the calls of the last with_shim command
+  local c
+  c=$(ccommd_calls)
+  echo "$c"
+  grep -qE '^deb-systemd-invoke( --[a-z-]+)* try-restart .*ccommd\.service' <<<"$c" || { echo "no try-restart"; return 1; }
+  ! grep -qE '(^| )(stop|start|restart) ' <<<"$c" || { echo "a stop/start/restart of ccommd"; return 1; }
+  ! grep -qE '(start|restart|stop) .*ccomm-board-net' "$calls" || { echo "ccomm-board-net touched"; return 1; }
+}
+with_shim apt-get install -y -q --reinstall -o Debug::NoLocking=1 -o DPkg::Path="$shim_path" "$T"/debs/ccommd_*.deb >"$T/reinstall.log" 2>&1
+check "apt-get install --reinstall ccommd ran the maintainer scripts" grep -q 'Setting up ccommd' "$T/reinstall.log"
+check "apt-get install --reinstall ccommd: no stop, a try-restart (a running ccommd keeps running)" upgrade_keeps_running
+with_shim dpkg-reconfigure ccommd >"$T/reconfigure.log" 2>&1
+check "dpkg-reconfigure ccommd: no stop, a try-restart" upgrade_keeps_running
+check "ccommd (started directly) survived the reinstall" kill -0 "$daemon"
+check "ccommd still serves node robot after the reinstall" ccomm --node robot list
 
 # ---- the user's C and C++ programs, built against the installed headers -------------------
 check "cmake: find_package(ccomm) project configures and builds" bash -c \
@@ -81,7 +126,9 @@ check "python3-ccomm: a write while ccommd is down tells the caller" \
 check "the wheel: a write while ccommd is down tells the caller" bash -c \
   "cd / && $T/venv/bin/python $T/talk.py --version $CCOMM_VERSION --library-under / --base 10 --daemon-stopped"
 check "apt purge removes the packages" \
-  apt-get purge -y -q -o Debug::NoLocking=1 ccommd libccomm0 libccomm-dev python3-ccomm
+  with_shim apt-get purge -y -q -o Debug::NoLocking=1 -o DPkg::Path="$shim_path" ccommd libccomm0 libccomm-dev python3-ccomm
+check "the removal stops ccommd (prerm)" bash -c "grep -qE '^deb-systemd-invoke( --[a-z-]+)* stop .*ccommd\.service' $calls || { cat $calls; false; }"
+rm -rf /run/systemd/system "$shim"
 check "nothing of ccommd left but the user" bash -c "! test -e /etc/ccomm/signals.xml && ! test -e /usr/bin/ccommd"
 
 echo "packages: $passed passed, $failed failed"

@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
-# U-Boot SPL (MLO) and U-Boot (u-boot.img) for the Gumstix Overo, cross-built from Debian's
-# u-boot source package with U-Boot's omap3_overo_defconfig: Debian's u-boot-omap carries
-# other OMAP boards (BeagleBoard, IGEP, Panda, ...), not the Overo.
-# KNOWN BROKEN: bookworm's u-boot source (2023.01) no longer has the Overo board (no
-# configs/omap3_overo_defconfig): do_dpkg_build stops at the configure step. It needs a
-# U-Boot that still has it (bullseye's 2021.01 source, or Gumstix's fork) (docs/yocto.md).
+# U-Boot SPL (MLO) and U-Boot (u-boot.img) for the RaMstix (Gumstix Overo), cross-built from
+# Debian bookworm's u-boot source package (2023.01) with the project's own board support:
+# U-Boot dropped the Overo in 2020, so meta-ccomm/bsp/u-boot-overo/ carries a patch adding
+# omap3_overo_ramstix_defconfig (docs/yocto.md, "The boot loader"). The same patch and
+# boot.cmd are what meta-ccomm/bsp/u-boot-overo/build (the mmdebstrap card) and the Yocto
+# bbappend use: one copy, found here through FILESEXTRAPATHS.
 # Package u-boot-ramstix: /usr/lib/u-boot/ramstix/{MLO,u-boot.img,boot.scr}, for the SD
-# card's FAT partition (IMAGE_BOOT_FILES of conf/machine/ramstix.conf); boot.scr is
-# files/boot.cmd made a U-Boot script by the mkimage this build makes.
+# card's FAT partition; boot.scr is boot.cmd made a U-Boot script by the mkimage this
+# build makes.
 DESCRIPTION = "U-Boot for the RaMstix (Gumstix Overo)"
 MAINTAINER = "the ccomm developers <ccomm-dev@lists.example.org>"
 LICENSE = "GPL-2.0-or-later"
@@ -15,10 +15,11 @@ LIC_FILES_CHKSUM = "file://${LAYERDIR_core}/licenses/COPYING.GPLv2;md5=751419260
 
 inherit dpkg
 
-SRC_URI = "apt://u-boot file://boot.cmd"
+FILESEXTRAPATHS:prepend := "${THISDIR}/../../../meta-ccomm/bsp/u-boot-overo:"
+SRC_URI = "apt://u-boot file://0001-omap3-ccomm-ramstix-board.patch file://boot.cmd"
 PV = "2023.01"
 S = "${WORKDIR}/u-boot-src"
-U_BOOT_CONFIG = "omap3_overo_defconfig"
+U_BOOT_CONFIG = "omap3_overo_ramstix_defconfig"
 COMPATIBLE_MACHINE = "^(ramstix)$"
 
 do_prepare_build[vardeps] += "U_BOOT_CONFIG"
@@ -50,7 +51,7 @@ endif
 override_dh_auto_configure:
 	$(MAKE) ${U_BOOT_CONFIG}
 override_dh_auto_build:
-	$(MAKE) $(PARALLEL_MAKE) MLO u-boot.img tools
+	$(MAKE) $(PARALLEL_MAKE) KCFLAGS=-Werror
 	tools/mkimage -A arm -O linux -T script -C none -n "RaMstix boot" -d debian/boot.cmd boot.scr
 override_dh_auto_test:
 override_dh_auto_install:

@@ -4,6 +4,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include <string>
+
 #include "common/platform.h"
 
 namespace ccomm {
@@ -36,11 +38,33 @@ void Log(LogLevel level, const char* fmt, ...) {
   char line[1024];
   int off = 0;
   if (g_sd_prefixes) off = snprintf(line, sizeof line, "<%d>", static_cast<int>(level));
-  va_list ap;
+  va_list ap, again;
   va_start(ap, fmt);
-  vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
+  va_copy(again, ap);
+  const int n = vsnprintf(line + off, sizeof line - static_cast<size_t>(off), fmt, ap);
   va_end(ap);
-  fprintf(g_log_file ? g_log_file : stderr, "%s\n", line);
+  FILE* out = g_log_file ? g_log_file : stderr;
+  if (n >= 0 && static_cast<size_t>(n) >= sizeof line - static_cast<size_t>(off)) {
+    // Longer than the buffer (a "no node ... is this board" listing many interfaces and
+    // nodes): whole, not cut; logging is never on a hot path.
+    std::string whole(static_cast<size_t>(n) + 1, '\0');
+    vsnprintf(&whole[0], whole.size(), fmt, again);
+    whole.resize(static_cast<size_t>(n));
+    fprintf(out, "%.*s%s\n", off, line, whole.c_str());
+  } else {
+    fprintf(out, "%s\n", line);
+  }
+  va_end(again);
+}
+
+void LogText(LogLevel level, const std::string& text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    size_t j = text.find('\n', i);
+    if (j == std::string::npos) j = text.size();
+    if (j > i) Log(level, "%.*s", static_cast<int>(j - i), text.c_str() + i);
+    i = j + 1;
+  }
 }
 
 }  // namespace ccomm

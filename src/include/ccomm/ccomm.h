@@ -420,8 +420,9 @@ typedef struct ccomm_production_age {
   int32_t code;      /**< ccomm_production_age_code */
   int32_t known;     /**< 1 for CCOMM_PAGE_SYNCED and _SAME_NODE (age_ns valid), else 0 */
   int64_t age_ns;    /**< since the producer wrote the value, as of this call; -1 when unknown */
-  int64_t error_ns;  /**< |true age - age_ns| <= error_ns (the two clocks' bounds plus 1 us for reading
-                          them); -1 when unknown: never an age presented as exact when it is not */
+  int64_t error_ns;  /**< |true age - age_ns| <= error_ns (the two clocks' bounds plus 2 us for reading
+                          their two offsets, 1 us each); -1 when unknown: never an age presented as
+                          exact when it is not */
   int64_t production_time_ns; /**< when the producer wrote the value, on the common time base: this
                                    board's CLOCK_REALTIME in ns since the epoch (within +/- error_ns);
                                    the DDS source timestamp and the recorder's publish time. -1 when

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define MODEL_IDENTIFIER plant3
 #include "fmi3_trivial.h"
 
 #ifndef SUBSTEPS

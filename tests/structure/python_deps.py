@@ -5,7 +5,7 @@ package that the step's scripts/setup groups install, and this interpreter sees 
 
     python_deps.py [--step STEP]...      (default: every step below)
 
-The cheap form of scripts/fresh-machine-check (under a second, run as a ctest): it catches
+The cheap form of scripts/fresh-machine-check (seconds, run as a ctest): it catches
 an import whose package no setup group names (a green CI on a used machine hides that:
 the package is there by chance), a module the interpreter finds outside Debian's packages
 (pip, pyenv) and a package that is installed but this interpreter does not see (the wrong
@@ -17,6 +17,7 @@ runner installs it from pinned requirements.
 """
 import argparse
 import ast
+import functools
 import importlib.util
 import os
 import subprocess
@@ -143,17 +144,20 @@ def third_party(paths, extra, local_dirs, step):
     return found
 
 
+@functools.lru_cache(maxsize=None)
 def setup_list(groups):
-    out = subprocess.run([os.path.join(ROOT, "scripts", "setup"), "--list"] + groups,
+    out = subprocess.run([os.path.join(ROOT, "scripts", "setup"), "--list"] + list(groups),
                          capture_output=True, text=True, check=True).stdout
     return set(out.split())
 
 
+@functools.lru_cache(maxsize=None)
 def installed(pkg):
     r = subprocess.run(["dpkg-query", "-W", "-f=${Status}", pkg], capture_output=True, text=True)
     return r.returncode == 0 and "install ok installed" in r.stdout
 
 
+@functools.lru_cache(maxsize=None)
 def owner(path):
     r = subprocess.run(["dpkg", "-S", path], capture_output=True, text=True)
     return r.stdout.split(":")[0].strip() if r.returncode == 0 else None
@@ -161,7 +165,7 @@ def owner(path):
 
 def check(step):
     groups, paths, extra, local_dirs = STEPS[step]
-    wanted = setup_list(groups)
+    wanted = setup_list(tuple(groups))
     mods = third_party(paths, extra, local_dirs, step)
     errors = []
     for mod, where in sorted(mods.items()):

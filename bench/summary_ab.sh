@@ -10,6 +10,7 @@ set -uo pipefail
 build=${1:?usage: bench/summary_ab.sh BUILD_DIR [ROUNDS] [SECONDS]}
 rounds=${2:-6} secs=${3:-3}
 bin=$build/bin
+. "$(dirname "$0")/../scripts/python.sh"  # Debian's Python, not PATH's (docs/testing.md, "Which Python")
 [ "$(id -u)" -eq 0 ] || { echo "summary_ab: needs root (network namespaces)" >&2; exit 4; }
 work=$(mktemp -d "${TMPDIR:-/tmp}/ccomm-summary-ab-XXXXXX")
 ns=ccsab$$
@@ -40,7 +41,7 @@ XML
     ip netns del "$ns"; rm -f /dev/shm/"$ns".$sm.*
   done
 done
-python3 - "$results" <<'PY'
+"$CCOMM_PYTHON" - "$results" <<'PY'
 import json, statistics, sys
 runs = {}
 for line in open(sys.argv[1]):

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # Helpers for the integration test scripts (sourced). Every test runs its own ccommd on a
 # private segment name (CCOMM_SHM_PREFIX) and stops exactly the processes it started.
+. "$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/scripts/python.sh"  # Debian's Python, not PATH's (docs/testing.md, "Which Python")
 
 export CCOMM_SHM_PREFIX="/ccomm-it-$$-"
 _it_pids=()

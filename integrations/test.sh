@@ -10,6 +10,7 @@
 # BUILD_DIR/integrations-venv). Exit status 0 only if every part passed.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/../scripts/python.sh"  # Debian's Python, not PATH's (docs/testing.md, "Which Python")
 repo=$(cd "$here/.." && pwd)
 B=$(cd "${1:?usage: integrations/test.sh BUILD_DIR}" && pwd)
 jobs=${JOBS:-2}
@@ -51,7 +52,7 @@ build() {
 python_tests() {
   local venv=$B/integrations-venv
   if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv" || { echo "python3 -m venv failed (Debian: apt-get install python3-venv)"; return 1; }
+    "$CCOMM_PYTHON" -m venv "$venv" || { echo "python3 -m venv failed (Debian: apt-get install python3-venv)"; return 1; }
   fi
   "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$repo/python/requirements-test.txt" || return 1
   # Exactly what the docs tell users: pip install ./python (a fresh copy each run).

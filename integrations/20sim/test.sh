@@ -107,19 +107,19 @@ it_stop "$vg"
 echo "== 20-sim C-code target: code generation for every integration method"
 for m in Discrete Euler RungeKutta2 RungeKutta4; do
   sed "s/\[CDATA\[Euler\]\]/[CDATA[$m]]/" "$here/example/PDController_tokens.xml" >"$out/t_$m.xml"
-  python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+  "$CCOMM_PYTHON" "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
     --tokens "$out/t_$m.xml" --out "$out/gen_$m" >/dev/null
   if ${CC:-cc} -std=c11 -Wall -Wextra -Wshadow -Werror -c -I"$here/../../src/include" \
       -o "$out/$m.o" "$out/gen_$m/xxinteg.c"; then echo "PASS $m compiles"; else echo "FAIL $m"; fail=1; fi
 done
-if python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+if "$CCOMM_PYTHON" "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
     --tokens <(sed 's/\[CDATA\[Euler\]\]/[CDATA[BDF]]/' "$here/example/PDController_tokens.xml") \
     --out "$out/gen_bdf" 2>"$out/e4"; then echo "FAIL unsupported method accepted"; fail=1;
 else echo "PASS unsupported method refused: $(cat "$out/e4")"; fi
 
 echo "== 20-sim C-code target: step order and integration methods against 20-sim's documented order"
 # StepOrder: derivative kick, two states, a gain matrix; sample by sample, all four methods.
-if python3 "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" \
+if "$CCOMM_PYTHON" "$here/test/step_order.py" --work "$out/step_order" --cc "${CC:-cc}" \
      --ccomm-include "$here/../../src/include" --ccomm-lib "$(cd "$bin/../lib" && pwd)"; then :; else fail=1; fi
 
 echo "== 20-sim C-code target: the matrix model (StepOrder, Euler) as a task against ccommd"
@@ -134,7 +134,7 @@ for i in $(seq 40); do
   sleep 0.05
   got_u=$("$bin/ccomm" --node ctrl echo u --once 2>&1) || true
   got_i=$("$bin/ccomm" --node ctrl echo integral --once 2>&1) || true
-  if python3 - "$got_u" "$got_i" <<'PY'
+  if "$CCOMM_PYTHON" - "$got_u" "$got_i" <<'PY'
 import re, sys
 u = re.match(r"u \[([^,\]]+), ([^\]]+)\] fresh", sys.argv[1])
 i = re.match(r"integral (\S+) fresh", sys.argv[2])
@@ -157,13 +157,13 @@ if ${CC:-cc} -std=c11 -Wall -Wextra -Wshadow -Werror -I"$out/step_order/gen_Eule
 else echo "FAIL matrix helpers"; fail=1; fi
 
 echo "== 20-sim C-code target: template language (%IF% with EQ/NEQ/NOT/AND/OR, undefined tokens)"
-if python3 "$here/test/tokensubst_check.py"; then :; else fail=1; fi
+if "$CCOMM_PYTHON" "$here/test/tokensubst_check.py"; then :; else fail=1; fi
 
 echo "== 20-sim C-code target: the documented function list against xxfuncs.c / xxmatrix.c"
-if python3 "$here/test/doc_functions.py" --cc "${CC:-cc}"; then :; else fail=1; fi
+if "$CCOMM_PYTHON" "$here/test/doc_functions.py" --cc "${CC:-cc}"; then :; else fail=1; fi
 
 echo "== 20-sim C-code target: the generated project builds with its own CMakeLists.txt"
-python3 "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
+"$CCOMM_PYTHON" "$here/tokensubst.py" --targets "$here/ccode-target/Targets.ini" --target ccomm \
   --tokens "$here/example/PDController_tokens.xml" --out "$out/user" >/dev/null
 if cmake -S "$out/user" -B "$out/user/build" -DCCOMM_INCLUDE_DIR="$here/../../src/include" \
      -DCCOMM_LIBRARY="$(cd "$bin/../lib" && pwd)/libccomm.so" >/dev/null &&
@@ -183,10 +183,10 @@ echo "== 20-sim 4C component: generator checks"
 export CCOMM_CCOMMD=$bin/ccommd  # the generator reads signals.xml through ccommd --check --json
 bad=$out/bad-signals.xml
 sed 's/type="double"/type="doubel"/' "$cfg" >"$bad"
-if python3 "$here/4c/gen_4c.py" "$bad" ctrl "$out/gb" 2>"$out/e6"; then echo "FAIL bad type accepted"; fail=1;
+if "$CCOMM_PYTHON" "$here/4c/gen_4c.py" "$bad" ctrl "$out/gb" 2>"$out/e6"; then echo "FAIL bad type accepted"; fail=1;
 elif grep -q "bad-signals.xml:[0-9]*: error" "$out/e6"; then echo "PASS ccommd's error for a bad file: $(head -1 "$out/e6")"
 else echo "FAIL bad file: no FILE:LINE error: $(cat "$out/e6")"; fail=1; fi
-if python3 "$here/4c/gen_4c.py" "$cfg" nosuch "$out/g" 2>"$out/e5"; then echo "FAIL unknown node accepted"; fail=1;
+if "$CCOMM_PYTHON" "$here/4c/gen_4c.py" "$cfg" nosuch "$out/g" 2>"$out/e5"; then echo "FAIL unknown node accepted"; fail=1;
 else echo "PASS unknown node refused: $(cat "$out/e5")"; fi
 if CCOMM_NODE=ctrl CCOMM_GEN_20SIM4C="$here/4c/gen_4c.py" "$bin/ccomm" gen 20sim4c "$cfg" "$out/gcli" >/dev/null &&
    grep -q '#define CCOMM4C_NODE "ctrl"' "$out/gcli/ccomm_4c.h"; then

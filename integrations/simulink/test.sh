@@ -21,12 +21,12 @@ it_start_ccommd "$bin" "$here/harness/signals.xml" sim
 "$ibin/ccomm_simulink_harness" sim || fail=1
 
 echo "== block library ccomm_lib.mdl"
-python3 "$here/check_mdl.py" "$here/ccomm_lib.mdl" || fail=1
+"$CCOMM_PYTHON" "$here/check_mdl.py" "$here/ccomm_lib.mdl" || fail=1
 # Broken copies must be refused, each with the line and the reason.
 refuse() {  # refuse WHAT SED-EXPRESSION EXPECTED-MESSAGE
   sed "$2" "$here/ccomm_lib.mdl" >"$out/broken.mdl"
   local got
-  if got=$(python3 "$here/check_mdl.py" "$out/broken.mdl" --common "$here/sfun_ccomm_common.h"); then
+  if got=$("$CCOMM_PYTHON" "$here/check_mdl.py" "$out/broken.mdl" --common "$here/sfun_ccomm_common.h"); then
     echo "FAIL $1: accepted"; fail=1
   elif grep -q -- "$3" <<<"$got"; then
     echo "PASS $1 refused: $(grep -m1 -- "$3" <<<"$got" | sed "s|$out/||")"
@@ -44,7 +44,7 @@ refuse "missing prompt" '0,/Data type|Timeout (s, 0 = only signals.xml decides)|
 refuse "unknown data type in the popup" '0,/popup(double|single|int32|uint32|boolean)/s//popup(double|int16)/' \
   "data type popup"
 mkdir -p "$out/fuzz"
-python3 "$here/check_mdl.py" "$here/ccomm_lib.mdl" --fuzz 300 --seed "${CCOMM_FUZZ_SEED:-$RANDOM}" --work "$out/fuzz" || fail=1
+"$CCOMM_PYTHON" "$here/check_mdl.py" "$here/ccomm_lib.mdl" --fuzz 300 --seed "${CCOMM_FUZZ_SEED:-$RANDOM}" --work "$out/fuzz" || fail=1
 
 if [ "$fail" = 0 ]; then echo "Simulink integration: all checks passed"; else echo "Simulink integration: FAILED"; fi
 exit "$fail"

@@ -102,7 +102,7 @@ for r in $RATES; do
 done
 [ -n "$wire" ] || wire=$(($(wire_lost) - lost0))
 
-report=$(python3 "$QT_REPO/qemu-tests/lib/latency_report.py" "$OUT" --max-loss-ccomm "$MAX_LOSS_CCOMM" \
+report=$("$CCOMM_PYTHON" "$QT_REPO/qemu-tests/lib/latency_report.py" "$OUT" --max-loss-ccomm "$MAX_LOSS_CCOMM" \
 	--max-loss-floor "$MAX_LOSS_FLOOR" --markdown "$QT_WORK/latency.md")
 rc=$?
 echo "$report"

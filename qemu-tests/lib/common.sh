@@ -9,6 +9,7 @@ KSFT_FAIL=1
 KSFT_SKIP=4
 
 : "${QT_VMCTL:?run the cases through qemu-tests/run}"
+: "${CCOMM_PYTHON:?run the cases through qemu-tests/run (it sets the Python: scripts/python.sh)}"
 
 QT_FAILED=0
 QT_CHECKS=0
@@ -121,9 +122,9 @@ wait_until() {
 
 # jcheck PYTHON-EXPRESSION < JSON: true if the expression, with the JSON document as d,
 # holds (e.g. the output of `ccomm stats --json`).
-jcheck() { python3 -c 'import json, sys; d = json.load(sys.stdin); sys.exit(0 if eval(sys.argv[1]) else 1)' "$1"; }
+jcheck() { "$CCOMM_PYTHON" -c 'import json, sys; d = json.load(sys.stdin); sys.exit(0 if eval(sys.argv[1]) else 1)' "$1"; }
 # jget PYTHON-EXPRESSION < JSON: prints the expression's value.
-jget() { python3 -c 'import json, sys; d = json.load(sys.stdin); print(eval(sys.argv[1]))' "$1"; }
+jget() { "$CCOMM_PYTHON" -c 'import json, sys; d = json.load(sys.stdin); print(eval(sys.argv[1]))' "$1"; }
 # sig_summary NAME < JSON: one signal's counters from `ccomm stats --json`.
 sig_summary() {
 	jget "(lambda s: 'writes=%d tx=%d rx=%d lost=%d coalesced=%d stale=%s stale_transitions=%d' % (s['writes'], s['tx'], s['rx'], s['lost'], s['coalesced'], s['stale'], s['stale_transitions']))([s for s in d['signals'] if s['name'] == '$1'][0])"

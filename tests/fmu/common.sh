@@ -8,7 +8,7 @@ FMPY_PINS=(fmpy==0.3.32 attrs==26.1.0 cmake==4.4.5 fastjsonschema==2.22.3 Jinja2
            traitlets==5.16.1 typing_extensions==4.16.0)
 venv=${FMPY_VENV:-$ROOT/.cache/fmpy-venv}
 if ! "$venv/bin/python" -c 'import fmpy, sys; sys.exit(fmpy.__version__ != "0.3.32")' 2>/dev/null; then
-  python3 -m venv "$venv" &&
+  "$CCOMM_PYTHON" -m venv "$venv" &&
     "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps "${FMPY_PINS[@]}" ||
     skip_all "cannot install FMPy from PyPI into $venv"
 fi

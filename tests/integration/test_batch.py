@@ -7,6 +7,7 @@ and the other handle's cC never takes one of them along."""
 import json
 import os
 import subprocess
+import sys
 import time
 
 from harness import BUILD, NodePair, python_env, signal_stats
@@ -29,13 +30,13 @@ def test_batch_step_leaves_in_one_frame(tmp_path):
     cfg = tmp_path / "batch.xml"
     cfg.write_text(CONFIG)
     with NodePair(config=str(cfg)) as pair:
-        sink = subprocess.Popen(pair.exec_prefix("planner") + ["python3", os.path.join(HERE, "frame_sink.py"),
+        sink = subprocess.Popen(pair.exec_prefix("planner") + [sys.executable, os.path.join(HERE, "frame_sink.py"),
                                                                "10.42.0.2", "47811", "3", str(tmp_path / "frames.jsonl")],
                                 stdout=subprocess.PIPE, text=True)
         assert json.loads(sink.stdout.readline()) == {"ready": True}
         pair.start("control")
         writer = subprocess.run(pair.exec_prefix("control") + [
-            "python3", os.path.join(HERE, "batch_writer.py"), os.path.join(BUILD, "lib", "libccomm.so"),
+            sys.executable, os.path.join(HERE, "batch_writer.py"), os.path.join(BUILD, "lib", "libccomm.so"),
             "control", str(CYCLES)], env=python_env(pair.env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
             timeout=120)
         assert writer.returncode == 0, writer.stdout

@@ -8,6 +8,7 @@ keeps four copies), the two before them are counted coalesced, and the planner c
 exactly that gap as lost. (tests/manyboards found writes == tx + coalesced + 1.)"""
 import os
 import subprocess
+import sys
 
 from harness import BUILD, NodePair, python_env, signal_stats, wait_for
 
@@ -41,7 +42,7 @@ def test_values_replaced_before_the_first_send_count_as_coalesced(tmp_path):
     with NodePair(config=str(cfg)) as pair:
         pair.start("control")
         pair.start("planner")
-        w = subprocess.run(pair.exec_prefix("control") + ["python3", "-c", WRITER,
+        w = subprocess.run(pair.exec_prefix("control") + [sys.executable, "-c", WRITER,
                                                           os.path.join(BUILD, "lib", "libccomm.so")],
                            env=python_env(pair.env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                            timeout=30)

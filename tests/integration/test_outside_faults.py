@@ -16,6 +16,7 @@ import signal
 import socket
 import struct
 import subprocess
+import sys
 import time
 import uuid
 
@@ -152,7 +153,7 @@ def test_summary_to_a_raw_node_without_mac_goes_to_every_station():
                 "  if f[:4]==b'CCMW' and f[5]&4 and struct.unpack('>H',f[6:8])[0]==0:\n"
                 "    print(struct.unpack('>H',f[28:30])[0]); sys.exit(0)\n"
                 "sys.exit(1)\n")
-        r = run(pair.exec_prefix("planner") + ["python3", "-c", code], check=False, timeout=30)
+        r = run(pair.exec_prefix("planner") + [sys.executable, "-c", code], check=False, timeout=30)
         assert r.returncode == 0, "no summary from control: " + r.stderr
         assert int(r.stdout) == 0xFFFF, "summary dest %s" % r.stdout
 

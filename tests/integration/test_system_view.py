@@ -199,7 +199,7 @@ def test_every_node_seen_rates_limits_and_death(system):
     # Rate limit, on the wire: over a window, each sender sends at most one summary frame
     # per part interval and destination (a and b report 62 signals: 2 parts, one per
     # 100 ms; c reports 2: 1 part, one per 200 ms).
-    counter = subprocess.Popen(["ip", "netns", "exec", s["ns"], "python3", os.path.join(HERE, "frame_counter.py"),
+    counter = subprocess.Popen(["ip", "netns", "exec", s["ns"], sys.executable, os.path.join(HERE, "frame_counter.py"),
                                 str(PORT), "2.0"], stdout=subprocess.PIPE, text=True)
     assert json.loads(counter.stdout.readline()) == {"ready": True}
     out = json.loads(counter.communicate(timeout=30)[0])
@@ -263,7 +263,7 @@ def forged_summary(sender, hash_, records, seq=1, t=None, dest=0, **bad):
 def send_from(s, src_ip, frame):
     code = ("import socket,sys; s=socket.socket(socket.AF_INET,socket.SOCK_DGRAM); s.bind((sys.argv[1],0)); "
             "s.sendto(bytes.fromhex(sys.argv[2]),('127.0.0.1',%d))" % PORT)
-    run(["ip", "netns", "exec", s["ns"], "python3", "-c", code, src_ip, frame.hex()])
+    run(["ip", "netns", "exec", s["ns"], sys.executable, "-c", code, src_ip, frame.hex()])
 
 
 def test_bad_summaries_refused_and_counted(system):

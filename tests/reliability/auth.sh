@@ -13,7 +13,7 @@ require_root
 require_build
 build_tool flood
 build_torture
-python3 -c 'import hashlib; hashlib.blake2b(b"", key=b"k", digest_size=16)' ||
+"$CCOMM_PYTHON" -c 'import hashlib; hashlib.blake2b(b"", key=b"k", digest_size=16)' ||
   skip_all "python3 without keyed BLAKE2b"
 
 KEY=$WORK/auth.key
@@ -38,12 +38,12 @@ check "a key file readable by others is refused (exit 3, says chmod 600)" \
 
 # 2. Independently built frames against the planner alone (control not running).
 DAEMON_CONFIG=$WORK/auth.xml start_daemon planner || { not_ok "planner starts with a key"; finish; }
-send() { in_ns control python3 "$REL_DIR/authframe.py" --ifname eth0 --key "$KEY" --hash "$HASH" "$@" >/dev/null; }
+send() { in_ns control "$CCOMM_PYTHON" "$REL_DIR/authframe.py" --ifname eth0 --key "$KEY" --hash "$HASH" "$@" >/dev/null; }
 settle() { sleep 0.2; stats planner; }
 stats planner
 rx0=$(counter planner frames_rx); rp0=$(counter planner frames_replayed)
 af0=$(counter planner frames_auth_failed); us0=$(counter planner frames_unknown_sender)
-T=$(python3 -c 'import time; print(time.monotonic_ns())')
+T=$("$CCOMM_PYTHON" -c 'import time; print(time.monotonic_ns())')
 send --sender 0 --dest 1 --seq 5 --send-ns "$T"; settle
 check "a heartbeat tagged by an independent implementation is accepted (frames_rx +$(delta planner frames_rx "$rx0"))" \
   [ "$(delta planner frames_rx "$rx0")" -eq 1 -a "$(peer planner heartbeats_rx)" -ge 1 ]
@@ -79,7 +79,7 @@ kill -TERM $w $c; wait $w $c
 final=$(grep '"final"' "$WORK/c.log")
 figure "checker at planner: $final"
 check "the values seen at the planner stayed valid and in order through the replays" \
-  python3 -c 'import json,sys; c=json.loads(sys.argv[1] or "{}")
+  "$CCOMM_PYTHON" -c 'import json,sys; c=json.loads(sys.argv[1] or "{}")
 sys.exit(0 if c.get("values", 0) > 100 and c.get("corrupt") is False and c.get("order_violations") == 0 else 1)' "$final"
 
 # 4. A wrong key on control, then no key at all on control: refused both ways, visibly.

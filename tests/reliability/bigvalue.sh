@@ -28,11 +28,11 @@ COUNTER=$BUILD/lib/ccomm_alloc_counter.so
 
 # sig NODE FIELD: a field of signal "path" from the last `stats NODE`
 sig() {
-  python3 -c 'import json,sys; s=[x for x in json.load(open(sys.argv[1]))["signals"] if x["name"]=="path"][0]
+  "$CCOMM_PYTHON" -c 'import json,sys; s=[x for x in json.load(open(sys.argv[1]))["signals"] if x["name"]=="path"][0]
 print(s[sys.argv[2]])' "$WORK/stats-$1.json" "$2"
 }
-jfield() { python3 -c 'import json,sys; print(json.loads(sys.argv[1])[sys.argv[2]])' "$1" "$2"; }
-imp_dropped() { python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j["a2b"]["dropped"] + j["b2a"]["dropped"])' "$1"; }
+jfield() { "$CCOMM_PYTHON" -c 'import json,sys; print(json.loads(sys.argv[1])[sys.argv[2]])' "$1" "$2"; }
+imp_dropped() { "$CCOMM_PYTHON" -c 'import json,sys; j=json.loads(sys.argv[1]); print(j["a2b"]["dropped"] + j["b2a"]["dropped"])' "$1"; }
 
 make_impaired_pair
 imp_start 11

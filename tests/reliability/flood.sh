@@ -110,7 +110,7 @@ run_transport() {  # run_transport raw|udp
   figure "$t: local writer: $lwf"
   figure "$t: local checker: $lcf"
   check "$t: local app on the flooded node served throughout, no corrupt value" \
-    python3 -c 'import json,sys; w=json.loads(sys.argv[1] or "{}"); c=json.loads(sys.argv[2] or "{}")
+    "$CCOMM_PYTHON" -c 'import json,sys; w=json.loads(sys.argv[1] or "{}"); c=json.loads(sys.argv[2] or "{}")
 sys.exit(0 if w.get("ok", 0) >= 2000 * 2 * float(sys.argv[3]) * 0.8 and w.get("busy") == 0 and
          c.get("values", 0) > 100 and c.get("corrupt") is False and c.get("order_violations") == 0 else 1)' \
     "$lwf" "$lcf" "$SECS"

@@ -39,7 +39,7 @@ alive_clients() {
   echo $n
 }
 corrupt_sum() {  # the signals' corrupt counters at NODE
-  stats_json "$1" | python3 -c 'import json,sys; print(sum(s.get("corrupt", 0) for s in json.load(sys.stdin)["signals"]))'
+  stats_json "$1" | "$CCOMM_PYTHON" -c 'import json,sys; print(sum(s.get("corrupt", 0) for s in json.load(sys.stdin)["signals"]))'
 }
 seq_of() { cli "$1" echo "$2" --once | sed -n 's/.* seq=\([0-9]*\).*/\1/p'; }
 

@@ -153,7 +153,7 @@ for c in "${CLIENTS[@]}"; do kill -TERM "${CPID[$c]}" 2>/dev/null; done
 for c in "${CLIENTS[@]}"; do wait "${CPID[$c]}" 2>/dev/null; done
 values=0; busy=0; full=0; order=0
 # Reopens: the highest count each client instance reported (killed ones included).
-reopens=$(cat "$WORK"/[wc]_*.log | python3 -c 'import json,sys
+reopens=$(cat "$WORK"/[wc]_*.log | "$CCOMM_PYTHON" -c 'import json,sys
 print(sum(json.loads(l).get("reopens", 0) for l in sys.stdin if l.startswith("{") and "\"final\"" in l))')
 reopens_seen=$(for f in "$WORK"/[wc]_*.log; do grep -o '"reopens":[0-9]*' "$f" | cut -d: -f2 | sort -n | tail -n1; done |
   awk '{s+=$1} END {print s+0}')
@@ -163,12 +163,12 @@ values_all=$(for f in "$WORK"/c_*.log; do grep -o '"values":[0-9]*' "$f" | cut -
 for f in "$WORK"/*.log; do
   line=$(grep '"final"' "$f" | tail -n1)
   [[ -n $line ]] || continue
-  read -r v _ b fu o < <(python3 -c 'import json,sys; d=json.loads(sys.argv[1])
+  read -r v _ b fu o < <("$CCOMM_PYTHON" -c 'import json,sys; d=json.loads(sys.argv[1])
 print(d.get("values",0), d.get("reopens",0), d.get("busy",0), d.get("full",0), d.get("order_violations",0))' "$line")
   values=$((values + v)); busy=$((busy + b)); full=$((full + fu)); order=$((order + o))
 done
 stats control; stats planner
-reclaimed() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["counters"].get("slots_reclaimed","n/a"))' "$WORK/stats-$1.json"; }
+reclaimed() { "$CCOMM_PYTHON" -c 'import json,sys; print(json.load(open(sys.argv[1]))["counters"].get("slots_reclaimed","n/a"))' "$WORK/stats-$1.json"; }
 figure "values validated: $values_all (at least; $values by the readers alive at the end); reopens after a" \
        "segment change: $reopens_seen; writes refused busy: $busy, full: $full (surviving writers); slots of" \
        "killed writers reclaimed by ccommd: control $(reclaimed control), planner $(reclaimed planner)"

@@ -9,6 +9,7 @@ set -uo pipefail
 
 REL_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 ROOT=$(cd "$REL_DIR/../.." && pwd)
+. "$ROOT/scripts/python.sh"  # Debian's Python, not PATH's (docs/testing.md, "Which Python")
 BUILD=${CCOMM_BUILD_DIR:-$ROOT/build/release}
 [[ $BUILD = /* ]] || BUILD=$ROOT/$BUILD
 BIN=$BUILD/bin
@@ -204,12 +205,12 @@ stats() { stats_json "$1" >"$WORK/stats-$1.json"; }
 stats_json() { cli "$1" stats --json --watch 0.005 | head -n1; }
 # counter NODE NAME: a daemon counter from the last stats NODE
 counter() {
-  python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["counters"][sys.argv[2]])' \
+  "$CCOMM_PYTHON" -c 'import json,sys; print(json.load(open(sys.argv[1]))["counters"][sys.argv[2]])' \
     "$WORK/stats-$1.json" "$2"
 }
 # peer NODE FIELD: a field of the (only) peer of NODE from the last stats NODE
 peer() {
-  python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))["peers"][0]; v=p[sys.argv[2]]
+  "$CCOMM_PYTHON" -c 'import json,sys; p=json.load(open(sys.argv[1]))["peers"][0]; v=p[sys.argv[2]]
 print(str(v).lower() if isinstance(v,bool) else v)' "$WORK/stats-$1.json" "$2"
 }
 # peer_up NODE: its stats (saved to stats-NODE.json) say the peer is alive. With wait_for:
@@ -228,7 +229,7 @@ rx_packets() { in_ns "$1" cat "/sys/class/net/${2:-eth0}/statistics/rx_packets";
 tx_dropped() { in_ns "$1" cat "/sys/class/net/${2:-eth0}/statistics/tx_dropped"; }
 # frames_total NODE: every frame ccommd looked at ends in exactly one of these counters.
 frames_total() {
-  python3 -c 'import json,sys; c=json.load(open(sys.argv[1]))["counters"]
+  "$CCOMM_PYTHON" -c 'import json,sys; c=json.load(open(sys.argv[1]))["counters"]
 print(sum(c[k] for k in ("frames_rx","frames_bad","frames_wrong_hash","frames_unknown_sender",
                          "frames_auth_failed","frames_replayed","frames_not_for_us")))' "$WORK/stats-$1.json"
 }
@@ -245,7 +246,7 @@ snapshot() {
   return 1
 }
 json_get() {  # json_get FILE KEY: a top-level field of the last JSON line of FILE
-  python3 -c 'import json,sys; print(json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])[sys.argv[2]])' "$1" "$2"
+  "$CCOMM_PYTHON" -c 'import json,sys; print(json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])[sys.argv[2]])' "$1" "$2"
 }
 
 # The impairment tool (impair.c, built by build_tool impair) between NS_C and NS_P in NS_M,

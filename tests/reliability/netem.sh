@@ -69,16 +69,16 @@ evaluate() {
       "FIGURE "*) figure "$MODE: ${line#FIGURE }" ;;
       *) not_ok "$MODE: phase_check: $line" ;;
     esac
-  done < <(python3 "$REL_DIR/phase_check.py" "$kind" "$AUTH" "$prev2" "${SNAPS[n - 2]}" "${SNAPS[n - 1]}" 2>&1)
+  done < <("$CCOMM_PYTHON" "$REL_DIR/phase_check.py" "$kind" "$AUTH" "$prev2" "${SNAPS[n - 2]}" "${SNAPS[n - 1]}" 2>&1)
 }
 jfield() {  # jfield FILE KEY: a field of the line with "final" in FILE
-  python3 -c 'import json,sys
+  "$CCOMM_PYTHON" -c 'import json,sys
 for l in open(sys.argv[1]):
     if "\"final\"" in l or "\"stale\"" in l: d=json.loads(l)
 print(d.get(sys.argv[2], ""))' "$1" "$2" 2>/dev/null
 }
 sigstat() {  # sigstat NODE SIGNAL FIELD: a field of a signal in ccomm stats --json
-  stats_json "$1" | python3 -c 'import json,sys
+  stats_json "$1" | "$CCOMM_PYTHON" -c 'import json,sys
 for s in json.load(sys.stdin)["signals"]:
     if s["name"] == sys.argv[1]: print(s[sys.argv[2]])' "$2" "$3"
 }
@@ -129,7 +129,7 @@ run_mode() {  # run_mode plain|auth
   spawn "$WORK/$MODE-stale-pong.json" control "$WORK/torture" -n control stale pong --timeout 10
   local sp=$!
   sleep 0.3
-  python3 "$REL_DIR/blackhole.py" --fifo "$WORK/imp.in" --ns "$NS_P" --ccomm "$BIN/ccomm" --node planner \
+  "$CCOMM_PYTHON" "$REL_DIR/blackhole.py" --fifo "$WORK/imp.in" --ns "$NS_P" --ccomm "$BIN/ccomm" --node planner \
     --signal beat >"$WORK/$MODE-blackhole.json" 2>&1
   wait $sb $sp
   local beat_ms pong_ms pong_safe down_ms sup_ms up_ms
@@ -148,24 +148,24 @@ run_mode() {  # run_mode plain|auth
   ages+=" $(jfield "$WORK/$MODE-stale-beat.json" first_stale_age_ms) ms; pong: fresh up to"
   ages+=" $(jfield "$WORK/$MODE-stale-pong.json" max_fresh_age_ms), stale from $(jfield "$WORK/$MODE-stale-pong.json" first_stale_age_ms)"
   check "$MODE: no read says fresh past stale_after_ms, the first stale read is past it ($ages)" \
-    python3 -c 'import json,sys
+    "$CCOMM_PYTHON" -c 'import json,sys
 ok = True
 for f in sys.argv[1:3]:
     d = [json.loads(l) for l in open(f) if l.startswith("{")][-1]
     ok &= "first_stale_age_ms" in d and d["max_fresh_age_ms"] <= d["stale_after_ms"] < d["first_stale_age_ms"]
 sys.exit(0 if ok else 1)' "$WORK/$MODE-stale-beat.json" "$WORK/$MODE-stale-pong.json"
   check "$MODE: apps see stale within stale_after_ms + ${SLACK} ms of the last value (beat $beat_ms, pong $pong_ms)" \
-    python3 -c 'import sys; v=[float(x) for x in sys.argv[1:3]]; sys.exit(0 if all(20 <= x <= 20 + float(sys.argv[3]) for x in v) else 1)' \
+    "$CCOMM_PYTHON" -c 'import sys; v=[float(x) for x in sys.argv[1:3]]; sys.exit(0 if all(20 <= x <= 20 + float(sys.argv[3]) for x in v) else 1)' \
     "${beat_ms:-0}" "${pong_ms:-0}" "$SLACK"
   check "$MODE: a stale setpoint reads as its safe value" [ "$pong_safe" = True ]
   # Measured from the cut, not from the last frame, which came up to one 5 ms period
   # (plus the 5 ms stats poll) earlier: hence the lower bound 20 - 6 ms.
   check "$MODE: ccommd counts the stale transition within stale_after_ms + $SUP_SLACK ms ($sup_ms)" \
-    python3 -c 'import sys; sys.exit(0 if 14 <= float(sys.argv[1]) <= 20 + float(sys.argv[2]) else 1)' "${sup_ms:--1}" "$SUP_SLACK"
+    "$CCOMM_PYTHON" -c 'import sys; sys.exit(0 if 14 <= float(sys.argv[1]) <= 20 + float(sys.argv[2]) else 1)' "${sup_ms:--1}" "$SUP_SLACK"
   check "$MODE: peer declared lost within peer_timeout_ms + $SUP_SLACK ms ($down_ms)" \
-    python3 -c 'import sys; sys.exit(0 if 300 <= float(sys.argv[1]) <= 300 + float(sys.argv[2]) else 1)' "${down_ms:--1}" "$SUP_SLACK"
+    "$CCOMM_PYTHON" -c 'import sys; sys.exit(0 if 300 <= float(sys.argv[1]) <= 300 + float(sys.argv[2]) else 1)' "${down_ms:--1}" "$SUP_SLACK"
   check "$MODE: peer back within a heartbeat period + 50 ms after the link returns ($up_ms)" \
-    python3 -c 'import sys; sys.exit(0 if 0 <= float(sys.argv[1]) <= 150 else 1)' "${up_ms:--1}"
+    "$CCOMM_PYTHON" -c 'import sys; sys.exit(0 if 0 <= float(sys.argv[1]) <= 150 else 1)' "${up_ms:--1}"
   sleep 1
   snap "$MODE-blackhole"
   evaluate all  # black hole and recovery: conservation (the gap is seen on recovery)
@@ -190,7 +190,7 @@ sys.exit(0 if ok else 1)' "$WORK/$MODE-stale-beat.json" "$WORK/$MODE-stale-pong.
   for f in cs ce; do
     figure "$MODE: checker $f: $(grep '"final"' "$WORK/$MODE-$f.log")"
     check "$MODE: checker $f saw values, none corrupt, none out of order" \
-      python3 -c 'import json,sys; c=json.loads(sys.argv[1] or "{}")
+      "$CCOMM_PYTHON" -c 'import json,sys; c=json.loads(sys.argv[1] or "{}")
 sys.exit(0 if c.get("values", 0) > 100 and c.get("corrupt") is False and c.get("order_violations") == 0 else 1)' \
       "$(grep '"final"' "$WORK/$MODE-$f.log")"
   done

@@ -124,7 +124,7 @@ if systemd-analyze --help 2>/dev/null | grep -q -- '--offline'; then
   score=$(sed -n 's/.*Overall exposure level for ccommd.service: \([0-9.]*\).*/\1/p' "$WORK/security.txt")
   figure "systemd-analyze security --offline: exposure $score ($(grep -o 'Overall.*' "$WORK/security.txt"))"
   check "unit exposure score <= $MAX_EXPOSURE ($score)" \
-    python3 -c 'import sys; sys.exit(0 if float(sys.argv[1] or 99) <= float(sys.argv[2]) else 1)' "$score" "$MAX_EXPOSURE"
+    "$CCOMM_PYTHON" -c 'import sys; sys.exit(0 if float(sys.argv[1] or 99) <= float(sys.argv[2]) else 1)' "$score" "$MAX_EXPOSURE"
   check "systemd-analyze verify accepts the unit" systemd-analyze verify --man=no "$WORK/ccommd.service"
 else
   note "systemd-analyze without --offline: unit checks skipped"
@@ -145,7 +145,7 @@ if command -v strace >/dev/null && command -v systemd-analyze >/dev/null; then
   kill -TERM "$(pgrep -P $st)"; wait $st
   stop_daemon planner
   used=$(sed -n 's/^[0-9]* *\(<... \)\{0,1\}\([a-z0-9_]*\)[( ].*/\2/p' "$WORK/strace.txt" | grep -v '^$' | sort -u)
-  denied=$(python3 - "$used" <<'EOF'
+  denied=$("$CCOMM_PYTHON" - "$used" <<'EOF'
 import subprocess, sys
 groups, cur = {}, None
 for line in subprocess.run(["systemd-analyze", "syscall-filter"], capture_output=True, text=True).stdout.splitlines():

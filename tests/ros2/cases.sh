@@ -80,7 +80,7 @@ ros_to_a() {  # ros_to_a SIGNAL ROS_TYPE VALUES_JSON EXPECT_JSON N [pub args]
 check "ROS 2 -> A: Float64MultiArray into double[3], fresh on board A" \
   ros_to_a setpoint Float64MultiArray '[[1.5,2.5,3.5],[4,5,6],[7,8,9]]' '[[1.5,2.5,3.5],[4,5,6],[7,8,9]]' 3 --interval 0.05
 check "ROS 2 -> A: Bool into bool" ros_to_a enable Bool '[true]' '[1]' 1
-events=$(python3 -c 'print(list(range(1, 51)))')
+events=$("$CCOMM_PYTHON" -c 'print(list(range(1, 51)))')
 check "ROS 2 -> A: 50 Int32 events, each once and in order" ros_to_a cmd Int32 "$events" "$events" 50 --event
 
 # ---- bad input from DDS: refused, counted, nothing (half-)written
@@ -110,7 +110,7 @@ check "a DDS writer of another type (Int32MultiArray) on the topic is refused an
 # ---- 1 kHz for 10 s, 36 doubles: zero loss, counted by the app, the bridge and the reader
 signal_stat() {  # signal_stat NODE SIGNAL FIELD: ccommd's per-signal counter
   stats "$1"
-  python3 -c 'import json,sys; d=json.load(open(sys.argv[1]))
+  "$CCOMM_PYTHON" -c 'import json,sys; d=json.load(open(sys.argv[1]))
 print([s for s in d["signals"] if s["name"] == sys.argv[2]][0][sys.argv[3]])' "$WORK/stats-$1.json" "$2" "$3"
 }
 # One run; sets KHZ_LOSS (values the reader missed) and KHZ_DDS_LOSS (published, not received).
@@ -174,7 +174,7 @@ if echo_start stale pos Float64 --count 1000000 --timeout 3 --deadline-ms 50; th
   wait "$ECHO_PID"
   wait "$a"
   ip -n "$NS_C" link set eth0 up
-  python3 - "$WORK/stale.result" "$WORK/stale.jsonl" "$cut" >"$WORK/stale.check" <<'PY'
+  "$CCOMM_PYTHON" - "$WORK/stale.result" "$WORK/stale.jsonl" "$cut" >"$WORK/stale.check" <<'PY'
 import json, sys
 res = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
 rows = [json.loads(l) for l in open(sys.argv[2])]
@@ -235,7 +235,7 @@ errs=$(bridge_stat joints dds_errors)
 check "  ... without a DDS error ($errs)" bash -c "[[ $errs -eq 0 ]]"
 
 # ---- fuzzed DDS samples: every sample is written whole or refused whole, and counted
-fuzz_values=$(python3 -c '
+fuzz_values=$("$CCOMM_PYTHON" -c '
 import json, random
 random.seed(2026)
 out = []
@@ -245,7 +245,7 @@ for _ in range(200):
     count = random.choice([n, n, n, 3, 0, 5, 2**32 - 1])
     out.append({"data": data, "count": count})
 print(json.dumps(out))')
-valid=$(python3 -c 'import json,sys; v=json.loads(sys.argv[1]); print(sum(1 for s in v if len(s["data"]) == 3 and s["count"] == 3))' "$fuzz_values")
+valid=$("$CCOMM_PYTHON" -c 'import json,sys; v=json.loads(sys.argv[1]); print(sum(1 for s in v if len(s["data"]) == 3 and s["count"] == 3))' "$fuzz_values")
 r0=$(bridge_stat setpoint received); w0=$(bridge_stat setpoint written); f0=$(bridge_stat setpoint refused_length)
 peer pub rt/ccomm/setpoint Float64MultiArray "$fuzz_values" --interval 0.003 >/dev/null
 r1=$(bridge_stat setpoint received); w1=$(bridge_stat setpoint written); f1=$(bridge_stat setpoint refused_length)

@@ -139,7 +139,7 @@ kill -0 $lpid 2>/dev/null && kill -0 $wpid 2>/dev/null || return 0
 
 # Per-signal tx (sending node) and rx/lost (receiving node) sums, from two stats snapshots.
 counters() {  # BEFORE_TX AFTER_TX BEFORE_RX AFTER_RX: prints "tx rx lost mismatched signals coalesced"
-  python3 - "$@" <<'PY'
+  "$CCOMM_PYTHON" - "$@" <<'PY'
 import json, sys
 btx, atx, brx, arx = (json.loads(open(f).read()) for f in sys.argv[1:5])
 sig = lambda s: {x["name"]: x for x in s["signals"]}
@@ -187,7 +187,7 @@ setup_simulation() {
     sleep 0.5
   done
   local p50 sent recv llost
-  read -r p50 sent recv llost < <(python3 -c 'import json,sys; r=json.load(open(sys.argv[1]));
+  read -r p50 sent recv llost < <("$CCOMM_PYTHON" -c 'import json,sys; r=json.load(open(sys.argv[1]));
 print(r["p50_ns"], r["sent"], r["received"], r["lost"])' "$W/ping.json")
   read -r txw rxw lostw badw nw cow <<<"$to_w"; read -r txl rxl lostl badl nl col <<<"$to_l"
   local dropw=$(($(udp_drops "$ns_w") - drops_w0)) dropl=$(($(udp_drops "$ns_l") - drops_l0))
@@ -207,7 +207,7 @@ check "setup-simulation Linux <-> Wine, 36 + 9 doubles at 1 kHz: every value arr
 
 # ---- c. junk ---------------------------------------------------------------------------
 junk() {  # IP: 20 datagrams of random bytes and one empty one to IP:47800
-  python3 - "$1" <<'PY'
+  "$CCOMM_PYTHON" - "$1" <<'PY'
 import os, socket, sys
 s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 for i in range(20):
@@ -215,7 +215,7 @@ for i in range(20):
 s.sendto(b"", (sys.argv[1], 47800))
 PY
 }
-counter() { python3 -c 'import json,sys; print(json.load(sys.stdin)["counters"][sys.argv[1]])' "$1"; }
+counter() { "$CCOMM_PYTHON" -c 'import json,sys; print(json.load(sys.stdin)["counters"][sys.argv[1]])' "$1"; }
 junk_frames() {
   local wb lb we le wb2 lb2 we2 le2
   wb=$(wstats | counter frames_bad) && lb=$(lstats | counter frames_bad) || return 1
@@ -255,7 +255,7 @@ link_cut() {
   sleep 0.5  # a few more stale readings
   kill $pub $reader 2>/dev/null; wait $pub $reader 2>/dev/null
   ip -n "$ns_l" link set eth0 up
-  tr -d '\r' <"$W/cut.out" | python3 -c '
+  tr -d '\r' <"$W/cut.out" | "$CCOMM_PYTHON" -c '
 import re, sys
 rows = [(m.group(1), int(m.group(2))) for m in (re.search(r" (fresh|stale)\*? seq=\d+ age_us=(-?\d+)", l) for l in sys.stdin) if m]
 fresh_old = [a for s, a in rows if s == "fresh" and a > 20000]

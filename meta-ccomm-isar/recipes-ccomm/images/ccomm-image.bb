@@ -22,11 +22,10 @@ IMAGE_INSTALL:append:qemuarm = " ccomm-bench"
 IMAGE_PREINSTALL += "systemd systemd-sysv busybox linuxptp kmod iproute2 procps socat iputils-ping openssh-server"
 
 # As the image from Debian's tools (meta-ccomm/image-debian/customize): root has no
-# password and must set one at the first login (on the serial console); SSH takes keys
-# only. No password that works over the network, none published.
+# password ('*': none matches) and SSH takes keys only; none is published. The owner adds
+# keys or a password hash before the first boot (docs/yocto.md, "First boot").
 USERS += "root"
-USER_root[password] = ""
-USER_root[flags] = "allow-empty-password force-passwd-change"
+USER_root[password] = "*"
 ROOTFS_POSTPROCESS_COMMAND += "ccomm_sshd_keys_only"
 ccomm_sshd_keys_only() {
     sudo install -D -m 644 '${CCOMM_TOPDIR}/meta-ccomm/image-debian/rootfs/etc/ssh/sshd_config.d/ccomm.conf' \

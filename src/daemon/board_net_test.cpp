@@ -2,6 +2,7 @@
 // ccommd --board-net's decision: which node (explicit, MAC before hostname), which
 // interface, which address (ip= /24, DHCP without ip=), and when to wait for the driver.
 #include "daemon/board_net.h"
+#include "daemon/local_interface_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -27,17 +28,6 @@ SystemConfig Cfg() {
   return cfg;
 }
 
-LocalInterface If(const char* name, const uint8_t* mac, std::vector<std::string> ips = {}) {
-  LocalInterface li;
-  li.name = name;
-  li.ipv4 = std::move(ips);
-  if (mac) {
-    li.has_mac = true;
-    memcpy(li.mac, mac, 6);
-  }
-  return li;
-}
-
 TEST(BoardNet, KernelCmdlineNode) {
   EXPECT_EQ(KernelCmdlineNode("console=ttyAMA0 ccomm.node=planner root=/dev/vda\n"), "planner");
   EXPECT_EQ(KernelCmdlineNode("ccomm.node=a ccomm.node=b"), "b");  // the kernel's rule: the last wins
@@ -49,7 +39,7 @@ TEST(BoardNet, MacBeforeHostname) {
   BoardNetPlan p;
   std::string err;
   // The image's hostname names the other board: the MAC decides.
-  ASSERT_EQ(PlanBoardNet(Cfg(), "", "", "control", {If("eth0", kMacB)}, false, &p, &err), 1) << err;
+  ASSERT_EQ(PlanBoardNet(Cfg(), "", "", "control", {If("eth0", {}, kMacB)}, false, &p, &err), 1) << err;
   EXPECT_EQ(p.node, 1);
   EXPECT_NE(p.how.find("planner by mac 52:54:00:42:00:02 on eth0"), std::string::npos) << p.how;
   EXPECT_EQ(p.interface, "eth0");
@@ -59,14 +49,14 @@ TEST(BoardNet, MacBeforeHostname) {
 TEST(BoardNet, ExplicitWinsAndHostnameIsTheFallback) {
   BoardNetPlan p;
   std::string err;
-  ASSERT_EQ(PlanBoardNet(Cfg(), "control", "ccomm.node=", "x", {If("eth0", kMacB)}, false, &p, &err), 1);
+  ASSERT_EQ(PlanBoardNet(Cfg(), "control", "ccomm.node=", "x", {If("eth0", {}, kMacB)}, false, &p, &err), 1);
   EXPECT_EQ(p.node, 0);
   EXPECT_EQ(p.how, "ccomm.node=");
   const uint8_t other[6] = {2, 0, 0, 0, 0, 7};
-  ASSERT_EQ(PlanBoardNet(Cfg(), "", "", "planner", {If("eth0", other)}, false, &p, &err), 1);
+  ASSERT_EQ(PlanBoardNet(Cfg(), "", "", "planner", {If("eth0", {}, other)}, false, &p, &err), 1);
   EXPECT_EQ(p.node, 1);
   EXPECT_EQ(p.how, "the hostname");
-  EXPECT_EQ(PlanBoardNet(Cfg(), "nope", "ccomm.node=", "planner", {If("eth0", kMacA)}, false, &p, &err), -1);
+  EXPECT_EQ(PlanBoardNet(Cfg(), "nope", "ccomm.node=", "planner", {If("eth0", {}, kMacA)}, false, &p, &err), -1);
   EXPECT_NE(err.find("has no node 'nope' (ccomm.node=; nodes: control, planner)"), std::string::npos) << err;
 }
 
@@ -76,12 +66,12 @@ TEST(BoardNet, WaitsForTheDriverThenSaysWhy) {
   const uint8_t other[6] = {2, 0, 0, 0, 0, 7};
   // Nothing matches yet (eth0 not probed): wait, and on the last try say every way tried.
   EXPECT_EQ(PlanBoardNet(Cfg(), "", "", "localhost", {}, false, &p, &err), 0);
-  EXPECT_EQ(PlanBoardNet(Cfg(), "", "", "localhost", {If("eth1", other)}, true, &p, &err), -1);
+  EXPECT_EQ(PlanBoardNet(Cfg(), "", "", "localhost", {If("eth1", {}, other)}, true, &p, &err), -1);
   EXPECT_NE(err.find("the hostname 'localhost' names none"), std::string::npos) << err;
   EXPECT_NE(err.find("ccomm.node=NAME"), std::string::npos) << err;
   // Known node, interface missing: wait, then name the file's line and the interfaces.
-  EXPECT_EQ(PlanBoardNet(Cfg(), "planner", "--node", "", {If("eth1", other)}, false, &p, &err), 0);
-  EXPECT_EQ(PlanBoardNet(Cfg(), "planner", "--node", "", {If("eth1", other)}, true, &p, &err), -1);
+  EXPECT_EQ(PlanBoardNet(Cfg(), "planner", "--node", "", {If("eth1", {}, other)}, false, &p, &err), 0);
+  EXPECT_EQ(PlanBoardNet(Cfg(), "planner", "--node", "", {If("eth1", {}, other)}, true, &p, &err), -1);
   EXPECT_NE(err.find("test.xml:11: this board is node 'planner' (--node) but has no interface 'eth0' "
                      "(interfaces: eth1)"),
             std::string::npos)
@@ -95,7 +85,7 @@ TEST(BoardNet, DhcpWithoutIpAndTheInterfaceOfTheMac) {
   cfg.nodes[1].transport = TransportKind::kUdp;
   BoardNetPlan p;
   std::string err;
-  ASSERT_EQ(PlanBoardNet(cfg, "", "", "", {If("enp1s0", kMacB)}, false, &p, &err), 1) << err;
+  ASSERT_EQ(PlanBoardNet(cfg, "", "", "", {If("enp1s0", {}, kMacB)}, false, &p, &err), 1) << err;
   EXPECT_EQ(p.interface, "enp1s0");
   EXPECT_EQ(p.address, "");
   const std::string f = BoardNetNetworkFile(cfg, p);
@@ -103,14 +93,14 @@ TEST(BoardNet, DhcpWithoutIpAndTheInterfaceOfTheMac) {
   EXPECT_NE(f.find("DHCP=ipv4\n"), std::string::npos) << f;
   EXPECT_EQ(f.find("Address="), std::string::npos) << f;
   // Static: Address= with the /24, kept through a cable cut.
-  ASSERT_EQ(PlanBoardNet(cfg, "control", "--node", "", {If("eth0", kMacA)}, false, &p, &err), 1) << err;
+  ASSERT_EQ(PlanBoardNet(cfg, "control", "--node", "", {If("eth0", {}, kMacA)}, false, &p, &err), 1) << err;
   const std::string s = BoardNetNetworkFile(cfg, p);
   EXPECT_NE(s.find("Address=10.42.0.1/24\n"), std::string::npos) << s;
   EXPECT_NE(s.find("IgnoreCarrierLoss=yes\n"), std::string::npos) << s;
   EXPECT_EQ(s.find("DHCP="), std::string::npos) << s;
   // A node with neither interface= nor a MAC on this board: hostname only.
   cfg.nodes[1].has_mac = false;
-  ASSERT_EQ(PlanBoardNet(cfg, "planner", "--node", "", {If("eth0", kMacA)}, false, &p, &err), 1) << err;
+  ASSERT_EQ(PlanBoardNet(cfg, "planner", "--node", "", {If("eth0", {}, kMacA)}, false, &p, &err), 1) << err;
   EXPECT_EQ(p.interface, "");
 }
 

@@ -2,6 +2,7 @@
 // One image for every board: which node a board is, from --node/$CCOMM_NODE, the
 // hostname, or its interfaces' MAC or IP; clear errors when none or several match.
 #include "daemon/node_identity.h"
+#include "daemon/local_interface_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -18,17 +19,6 @@ SystemConfig Cfg() {
   const uint8_t mac[6] = {0x52, 0x54, 0, 0x12, 0x34, 0x02};
   memcpy(cfg.nodes[1].mac, mac, 6);
   return cfg;
-}
-
-LocalInterface If(const char* name, std::vector<std::string> ips, const uint8_t* mac = nullptr) {
-  LocalInterface li;
-  li.name = name;
-  li.ipv4 = std::move(ips);
-  if (mac) {
-    li.has_mac = true;
-    memcpy(li.mac, mac, 6);
-  }
-  return li;
 }
 
 TEST(NodeIdentity, ExplicitNameWinsAndMustExist) {

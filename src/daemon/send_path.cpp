@@ -79,7 +79,7 @@ void SendPath::Prepare(bool adopted) {
   const uint32_t n = segment_.signal_count();
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
-  collected_states_.assign(n, 0);  // RunTx never allocates: a state is taken at most once a round
+  step_states_.clear();
   large_pending_.clear();
   large_pending_.reserve(n);  // at most one entry per signal and round
   tx_state_.assign(n, store::StateView());
@@ -101,6 +101,7 @@ void SendPath::Prepare(bool adopted) {
              consumers_[id].size() == 1 && !ps.large;
     if (t.fast) t.peer = &peers_tx_[consumers_[id][0]];
   }
+  PrepareCatchUp();
 }
 
 void SendPath::StartPeriods(uint64_t now) {
@@ -170,6 +171,12 @@ __attribute__((always_inline)) inline void SendPath::AddEntry(uint32_t id, const
   tx.store(tx.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
 
+// AddEntry for the rarer paths in other files (send_catch_up.cpp): AddEntry stays inline here.
+__attribute__((noinline)) void SendPath::AddEntryCold(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags,
+                                                      const store::SlotMeta& m, const void* value, uint64_t now) {
+  AddEntry(id, d, flags, m, value, now);
+}
+
 // The common case (TxSignal::fast: a state, one int64/double, one stream) in a small
 // function of its own, so that it saves and restores few registers; every rarer case
 // (no frame open or full, a damaged copy, values to catch up) calls out of line.
@@ -189,10 +196,10 @@ void SendPath::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (__builtin_expect(r != store::StoreResult::kOk, 0)) return TxReadFailed(id, r);  // never forwarded
   store::MarkStateForwarded(sv, version);
   if (!periodic) {
-    collected_states_[collected_count_++] = id;  // at most once per signal and round
     const uint64_t last = s.last_seq;
-    if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0))  // as in CollectSignalSlow
-      CatchUpAndCount(id, last, m.value_seq, now);
+    // Behind the writer: the value goes out after the round's loop, with the older ones
+    // still in its slots (send_catch_up.cpp). As in CollectSignalSlow.
+    if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0)) return DeferCatchUp(id);
   }
   s.last_seq = m.value_seq;
   PeerTx& p = *s.peer;
@@ -206,12 +213,6 @@ void SendPath::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
 
 __attribute__((noinline, cold)) void SendPath::TxReadFailed(uint32_t id, store::StoreResult r) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
-}
-
-__attribute__((noinline)) void SendPath::CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest,
-                                                         uint64_t now) {
-  const uint64_t gone = CatchUp(id, segment_.dir(id), last_sent, newest, now);
-  if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
 }
 
 __attribute__((noinline)) void SendPath::AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns,
@@ -252,76 +253,18 @@ void SendPath::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
-  if (!periodic) collected_states_[collected_count_++] = id;  // at most once per signal and round
   uint64_t& last = tx_signals_[id].last_seq;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
   if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {
-    const uint64_t gone = CatchUp(id, d, last, m.value_seq, now);
+    if (!prepared_[id].large) return DeferCatchUp(id);  // as in CollectSignal
+    const uint64_t gone = CatchUp(id, d, last, m.value_seq, now);  // fragments: never in a step's frame
     if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
   }
   last = m.value_seq;
   AddEntry(id, d, 0, m, tx_value_, now);
 }
 
-
-// An event-driven state sends every value once. When its writer was faster than this
-// thread (ccommd descheduled, a late cycle writing two steps back to back), the values
-// between the last one sent and the newest are usually still in the cell's slots
-// (kStateSlots copies): they go out first, in order, in the same frame, so a recorder or
-// history tap downstream gets every value and nothing is coalesced. Bounded by
-// kStateSlots - 1 reads; a value already overwritten counts as coalesced.
-uint64_t SendPath::CatchUp(uint32_t id, const store::SignalDirectoryEntry& d, uint64_t last_sent, uint64_t newest,
-                           uint64_t now) {
-  const store::StateView& sv = tx_state_[id];
-  const uint64_t first = newest - last_sent - 1 >= store::kStateSlots ? newest - (store::kStateSlots - 1) : last_sent + 1;
-  uint64_t gone = first - last_sent - 1;
-  for (uint64_t seq = first; seq < newest; ++seq) {
-    store::SlotMeta om;
-    const store::StoreResult r = store::StateReadTicket(sv, seq - 1, tx_older_, &om);
-    if (r == store::StoreResult::kCorrupt) segment_.stats(id).corrupt.fetch_add(1, std::memory_order_relaxed);
-    if (r != store::StoreResult::kOk || om.value_seq != seq) {
-      ++gone;
-      continue;
-    }
-    AddEntry(id, d, 0, om, tx_older_, now);
-  }
-  return gone;
-}
-
-// A batch step stores its signals one after another; if one landed while this round was
-// collecting, the frames may hold some of its values and the previous step's others. So
-// the round waits for steps in progress (bounded), then appends the newer values of every
-// state it took to the frames still open (after the older ones, see CatchUp): each step's
-// outputs leave together and in order, whatever the timing of ccommd against the writers.
-// The common case costs two loads.
-void SendPath::SettleSteps(uint32_t steps_before, uint64_t now) {
-  store::SegmentHeader* h = segment_.header();
-  for (int pass = 0; pass < 8; ++pass) {
-    for (int spin = 0; spin < 4096 && h->steps_active.load(std::memory_order_acquire) != 0; ++spin)
-      platform::CpuRelax();  // a flush stores a few values: microseconds
-    const uint32_t steps_now = h->steps_done.load(std::memory_order_acquire);
-    if (steps_now == steps_before) return;
-    steps_before = steps_now;
-    for (uint32_t i = 0; i < collected_count_; ++i) {
-      const uint32_t id = collected_states_[i];
-      const store::StateView& sv = tx_state_[id];
-      const uint64_t version = store::StateVersion(sv);
-      if (version == store::StateForwarded(sv)) continue;  // unchanged since it was taken
-      store::SlotMeta m;
-      if (store::StateRead(sv, tx_value_, &m) != store::StoreResult::kOk) continue;
-      store::MarkStateForwarded(sv, version);
-      uint64_t& last = tx_signals_[id].last_seq;
-      if (m.value_seq <= last) continue;
-      // The newer step's values follow the ones already in the frame (and any between,
-      // from the slots): each step leaves whole, in order, and nothing is replaced.
-      const uint64_t gone = m.value_seq > last + 1 ? CatchUp(id, segment_.dir(id), last, m.value_seq, now) : 0;
-      if (gone) segment_.stats(id).coalesced.fetch_add(gone, std::memory_order_relaxed);
-      last = m.value_seq;
-      AddEntry(id, segment_.dir(id), 0, m, tx_value_, now);
-    }
-  }
-}
 
 void SendPath::SendLargeValues(uint64_t now) {
   sending_large_ = true;  // CollectSignal sends now instead of queueing
@@ -363,7 +306,6 @@ void SendPath::RunTx() {
     uint32_t snapshot = h->tx_doorbell.load(std::memory_order_acquire);
     uint64_t now = platform::MonotonicNs();
     const uint32_t steps_before = h->steps_done.load(std::memory_order_acquire);
-    collected_count_ = 0;
     for (uint32_t w = 0; w < words; ++w) {
       uint64_t bits = dirty[w].exchange(0, std::memory_order_acq_rel);
       while (bits) {

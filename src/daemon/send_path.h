@@ -81,8 +81,23 @@ class SendPath {
   void CollectSignal(uint32_t id, uint64_t now, bool periodic);
   void CollectSignalSlow(uint32_t id, uint64_t now, bool periodic);  // all but TxSignal::fast
   void TxReadFailed(uint32_t id, store::StoreResult r);
-  void CatchUpAndCount(uint32_t id, uint64_t last_sent, uint64_t newest, uint64_t now);
   void AddEntryOutOfLine(uint32_t id, uint64_t value_seq, uint64_t source_time_ns, uint64_t word, uint64_t now);
+  // Behind the writers (send_catch_up.cpp).
+  struct DeferredState {  // a state found more than one value ahead of the last one sent
+    uint32_t id = 0;
+    uint32_t staged = 0;   // values copied into the staging area (this attempt)
+    uint64_t cut = 0;      // its `latest` at the cut
+    uint64_t gone = 0;     // values since the last one sent no longer in its slots
+    uint64_t corrupt = 0;  // copies that failed their check
+    size_t stage_at = 0;   // its first value in stage_bytes_
+    uint32_t meta_at = 0;  // and in stage_meta_
+  };
+  void PrepareCatchUp();
+  void WaitForSteps();
+  void DeferCatchUp(uint32_t id);
+  void SendDeferred(uint64_t now);
+  bool StageDeferred();
+  void CommitDeferred(uint64_t now);
   void SettleSteps(uint32_t steps_before, uint64_t now);
   /// Adds the values of state `id` written after `last_sent` and before the newest one
   /// (value_seq `newest`) that its slots still hold, oldest first; returns how many of
@@ -91,6 +106,8 @@ class SendPath {
                    uint64_t now);
   void AddEntry(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
                 const void* value, uint64_t now);
+  void AddEntryCold(uint32_t id, const store::SignalDirectoryEntry& d, uint8_t flags, const store::SlotMeta& m,
+                    const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
   // Large values (docs/protocol.md, "Large values"): one fragment entry per frame, after
@@ -126,9 +143,14 @@ class SendPath {
   std::vector<store::RingCursor> fwd_cursors_;    // signal -> send-side event cursor
   std::vector<store::StateView> tx_state_;        // signal -> its cell (forwarded states)
   std::vector<TxSignal> tx_signals_;              // signal -> its send record
-  std::vector<uint32_t> collected_states_;        // state signals taken this send round: [0, collected_count_)
-  uint32_t collected_count_ = 0;
+  std::vector<uint32_t> step_states_;             // forwarded small states sent on write (a batch step's kind)
   std::vector<LargePending> large_pending_;       // large values due this send round
+  std::vector<DeferredState> deferred_;           // states to catch up this round: [0, deferred_count_)
+  uint32_t deferred_count_ = 0;
+  std::vector<uint8_t> deferred_mark_;            // signal -> in deferred_ now
+  std::vector<uint8_t> stage_bytes_;              // the deferred states' values (kStateSlots each, 8-aligned)
+  std::vector<store::SlotMeta> stage_meta_;       // and their metadata
+  bool steps_wait_ = true;                        // WaitForSteps waits (no wait timed out since a step ended)
   bool sending_large_ = false;
   // Send on the cycle.
   uint32_t cycle_generation_ = UINT32_MAX;  // the grid due_ns_ is on (none yet)

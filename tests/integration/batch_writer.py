@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Control step for test_batch.py, through libccomm's C API (ctypes): a CCOMM_OPEN_BATCH
 handle writes bA, then a second, plain handle writes cC (its doorbell wakes ccommd in the
-middle of the step), then the batch handle writes bB and flushes. N cycles.
+middle of the step), then the batch handle writes bB and flushes. N cycles. With
+PAUSE_US 0 the steps follow each other back to back (ccommd lags behind them).
 
-    python3 batch_writer.py LIBCCOMM NODE CYCLES
+    python3 batch_writer.py LIBCCOMM NODE CYCLES [PAUSE_US (default 1000)]
 """
 import ctypes
 import sys
@@ -11,6 +12,7 @@ import time
 
 lib = ctypes.CDLL(sys.argv[1])
 node, cycles = sys.argv[2].encode(), int(sys.argv[3])
+pause = (float(sys.argv[4]) if len(sys.argv) > 4 else 1000.0) / 1e6  # per step: 30 % mid-step, 70 % after
 lib.ccomm_write_double.argtypes = [ctypes.c_void_p, ctypes.c_int32, ctypes.c_double]
 lib.ccomm_flush.argtypes = [ctypes.c_void_p]
 lib.ccomm_find.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
@@ -30,8 +32,10 @@ cc = lib.ccomm_find(plain, b"cC")
 for i in range(1, cycles + 1):
     assert lib.ccomm_write_double(batch, a, float(i)) == 0
     assert lib.ccomm_write_double(plain, cc, float(i)) == 0  # rings the doorbell now
-    time.sleep(0.0003)  # ccommd wakes and sends cC while the step is still open
+    if pause:
+        time.sleep(0.3 * pause)  # ccommd wakes and sends cC while the step is still open
     assert lib.ccomm_write_double(batch, b, float(i)) == 0
     assert lib.ccomm_flush(batch) == 0
-    time.sleep(0.0007)
+    if pause:
+        time.sleep(0.7 * pause)
 print("wrote", cycles)

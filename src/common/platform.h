@@ -131,6 +131,11 @@ bool ParseIpv4(const char* text, uint32_t* network_order);
 /// segment's access follows the mapping's namespace, docs/install.md). Start-up only.
 int NamedGroupId(const char* name);
 
+/// Whether stderr is the journal's stream (systemd sets JOURNAL_STREAM to its
+/// "device:inode"; a child whose stderr was redirected inherits the variable but not the
+/// stream, so both are compared): then log lines carry sd-daemon priority prefixes.
+bool StderrIsJournal();
+
 }  // namespace platform
 
 /// Logging for start-up, shutdown and rare events; never used per message. Lines go to

@@ -5,8 +5,12 @@
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <stdlib.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <string>
 
 namespace {
 
@@ -46,6 +50,24 @@ TEST(SocketDrops, CountsWhatTheReceiveBufferCouldNotHold) {
 TEST(SocketDrops, ReportsABadDescriptor) {
   uint32_t drops = 0;
   EXPECT_LT(ccomm::platform::SocketDrops(-1, &drops), 0);
+}
+
+TEST(StderrIsJournal, ComparesTheStreamWithStderr) {
+  struct stat st;
+  ASSERT_EQ(fstat(STDERR_FILENO, &st), 0);
+  const std::string mine = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  const std::string other = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino + 1);
+  ASSERT_EQ(unsetenv("JOURNAL_STREAM"), 0);
+  EXPECT_FALSE(ccomm::platform::StderrIsJournal());
+  ASSERT_EQ(setenv("JOURNAL_STREAM", mine.c_str(), 1), 0);
+  EXPECT_TRUE(ccomm::platform::StderrIsJournal());
+  ASSERT_EQ(setenv("JOURNAL_STREAM", other.c_str(), 1), 0);  // inherited, stderr redirected since
+  EXPECT_FALSE(ccomm::platform::StderrIsJournal());
+  ASSERT_EQ(setenv("JOURNAL_STREAM", (mine + "x").c_str(), 1), 0);
+  EXPECT_FALSE(ccomm::platform::StderrIsJournal());
+  ASSERT_EQ(setenv("JOURNAL_STREAM", "", 1), 0);
+  EXPECT_FALSE(ccomm::platform::StderrIsJournal());
+  unsetenv("JOURNAL_STREAM");
 }
 
 }  // namespace

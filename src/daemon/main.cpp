@@ -162,7 +162,7 @@ int RunDaemon(int argc, char** argv) {
   std::string network_dir = "/run/systemd/network";
   bool network_dir_given = false;
   // Under systemd every line gets its priority, also a usage error's (journalctl -p err).
-  SetLogPrefixes(getenv("JOURNAL_STREAM") != nullptr);
+  SetLogPrefixes(platform::StderrIsJournal());
   opterr = 0;
   int ch;
   while ((ch = getopt_long(argc, argv, "c:n:vqhV", kLong, nullptr)) != -1) {

@@ -33,11 +33,30 @@ def write(d, name, text):
     return path
 
 
-def in_namespace(script, timeout=40, env=None):
-    """Runs a bash script in new network + UTS namespaces (hostname 'localhost')."""
-    full = "set -e\nhostname localhost\n" + textwrap.dedent(script)
+# systemd's JOURNAL_STREAM: the "device:inode" of the stream stderr is on (ccommd compares it
+# with its stderr; an inherited variable whose stream is not stderr any more means no journal).
+AS_JOURNAL = "export JOURNAL_STREAM=$(stat -L -c %d:%i /proc/self/fd/2)\n"
+
+
+def in_namespace(script, timeout=40, env=None, journal=False):
+    """Runs a bash script in new network + UTS namespaces (hostname 'localhost'); journal:
+    its stderr stands for the journal's stream (JOURNAL_STREAM names it)."""
+    full = "set -e\nhostname localhost\n" + (AS_JOURNAL if journal else "") + textwrap.dedent(script)
     return subprocess.run(["unshare", "--net", "--uts", "bash", "-c", full], capture_output=True, text=True,
                           timeout=timeout, env=env)
+
+
+def run_as_journal(cmd, timeout=20):
+    """Runs cmd with stderr on a pipe that JOURNAL_STREAM names, as systemd's journal stream."""
+    r, w = os.pipe()
+    st = os.fstat(w)
+    env = dict(os.environ, JOURNAL_STREAM="%d:%d" % (st.st_dev, st.st_ino))
+    with os.fdopen(r) as err:
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=w, env=env, text=True)
+        os.close(w)
+        text = err.read()
+        proc.wait(timeout=timeout)
+    return subprocess.CompletedProcess(cmd, proc.returncode, "", text)
 
 
 def test_board_net_by_mac_sets_hostname_link_and_address():
@@ -91,14 +110,13 @@ def test_board_net_kernel_cmdline_wins_and_no_ip_means_dhcp():
 def test_board_net_no_node_is_an_error_at_priority_3():
     with tempfile.TemporaryDirectory() as d:
         cfg = write(d, "signals.xml", CONFIG.format(port=47892, ip1="10.42.0.1", ip2='ip="10.42.0.2"', transport="raw"))
-        env = dict(os.environ, JOURNAL_STREAM="8:1234")
         t0 = time.monotonic()
-        r = in_namespace(f"""
+        r = in_namespace(journal=True, script=f"""
             ip link add eth0 type veth peer name veth1
             ip link set eth0 address 02:00:00:00:00:09
             {CCOMMD} --config {cfg} --board-net --network-dir {d}/n || echo "EXIT $?"
             echo "HOST $(hostname)"
-            """, env=env)
+            """)
         took = time.monotonic() - t0
         assert "EXIT 1" in r.stdout, r.stdout + r.stderr
         assert "HOST localhost" in r.stdout, r.stdout
@@ -112,22 +130,22 @@ def test_fatal_config_errors_carry_priority_3():
         bad = write(d, "bad.xml", CONFIG.format(port=47893, ip1="10.42.0.1", ip2='ip="10.42.0.2"', transport="raw")
                     .replace('type="double" producer="planner"', 'type="dubble" producer="planner"')
                     .replace('producer="control" consumers', 'producer="nobody" consumers'))
-        env = dict(os.environ, JOURNAL_STREAM="8:1234")
-        r = subprocess.run([CCOMMD, "--config", bad, "--no-rt"], capture_output=True, text=True, env=env, timeout=20)
+        r = run_as_journal([CCOMMD, "--config", bad, "--no-rt"])
         assert r.returncode == 1, r.stderr
         lines = [l for l in r.stderr.splitlines() if l.strip()]
         located = [l for l in lines if re.match(r"^<3>" + re.escape(bad) + r":\d+:", l)]
         assert len(located) >= 2, "FILE:LINE errors without <3>:\n" + r.stderr
         assert all(l.startswith("<") for l in lines), "a line without a priority prefix:\n" + r.stderr
         # A usage error (a bad CCOMMD_OPTS) too, not getopt's unprefixed message.
-        r = subprocess.run([CCOMMD, "--config", bad, "--no-such-option"], capture_output=True, text=True, env=env,
-                           timeout=20)
+        r = run_as_journal([CCOMMD, "--config", bad, "--no-such-option"])
         assert r.returncode == 2, r.stderr
         assert r.stderr.startswith("<3>ccommd: unknown option or missing argument: '--no-such-option'"), r.stderr
-        # Without journald (a terminal) the lines stay as they were, no prefix.
-        r = subprocess.run([CCOMMD, "--check", bad], capture_output=True, text=True, timeout=20,
-                           env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"})
-        assert r.returncode == 1 and re.search("^" + re.escape(bad) + r":\d+:", r.stderr, re.M), r.stderr
+        # Without journald (a terminal) the lines stay as they were, no prefix; also when the
+        # variable was inherited but stderr is another stream now (ccommd run from a unit's script).
+        for env in ({k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"},
+                    dict(os.environ, JOURNAL_STREAM="8:1234")):
+            r = subprocess.run([CCOMMD, "--check", bad], capture_output=True, text=True, timeout=20, env=env)
+            assert r.returncode == 1 and re.search("^" + re.escape(bad) + r":\d+:", r.stderr, re.M), r.stderr
 
 
 def test_no_node_error_priority_3_and_the_wait_ends_on_the_hostname():
@@ -137,11 +155,12 @@ def test_no_node_error_priority_3_and_the_wait_ends_on_the_hostname():
     with tempfile.TemporaryDirectory() as d:
         cfg = write(d, "signals.xml", CONFIG.format(port=47894, ip1="127.0.0.1", ip2='ip="127.0.0.2"', transport="udp")
                     .replace(' mac="52:54:00:42:00:01"', "").replace(' mac="52:54:00:42:00:02"', ""))
-        env = dict(os.environ, JOURNAL_STREAM="8:1234", CCOMM_SHM_PREFIX=f"/ccq-fb{os.getpid()}.")
+        env = dict(os.environ, CCOMM_SHM_PREFIX=f"/ccq-fb{os.getpid()}.")
         env.pop("CCOMM_NODE", None)
         r = in_namespace(f"""
             ip link set lo up
-            {CCOMMD} --config {cfg} --no-rt --ptp-socket none 2>{d}/log &
+            touch {d}/log
+            JOURNAL_STREAM=$(stat -c %d:%i {d}/log) {CCOMMD} --config {cfg} --no-rt --ptp-socket none 2>{d}/log &
             pid=$!
             sleep 1.5
             hostname planner
@@ -153,7 +172,7 @@ def test_no_node_error_priority_3_and_the_wait_ends_on_the_hostname():
             cat {d}/log >&2
             hostname localhost
             {CCOMMD} --config {cfg} --no-rt --ptp-socket none || echo "EXIT $?"
-            """, env=env, timeout=60)
+            """, env=env, timeout=60, journal=True)
         assert "RUNNING" in r.stdout, r.stdout + r.stderr
         found_ms = int(re.search(r"FOUND_MS (\d+)", r.stdout).group(1))
         assert found_ms < 1000, f"ccommd saw the hostname {found_ms} ms after it was set\n" + r.stderr
@@ -172,8 +191,7 @@ def test_a_long_fatal_error_is_whole():
         nodes = "\n".join(f'  <node name="a_rather_long_node_name_{i:02d}" ip="10.9.{i}.1" transport="udp"/>'
                           for i in range(64))
         cfg = write(d, "many.xml", f'<?xml version="1.0"?>\n<ccomm version="1">\n{nodes}\n</ccomm>\n')
-        env = dict(os.environ, JOURNAL_STREAM="8:1234")
-        r = in_namespace(f"{CCOMMD} --which-node --config {cfg} || echo \"EXIT $?\"", env=env)
+        r = in_namespace(f"{CCOMMD} --which-node --config {cfg} || echo \"EXIT $?\"", journal=True)
         assert "EXIT 1" in r.stdout, r.stdout + r.stderr
         line = [l for l in r.stderr.splitlines() if "no node of" in l]
         assert len(line) == 1 and line[0].startswith("<3>ccommd: no node of"), r.stderr

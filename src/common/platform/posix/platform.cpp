@@ -14,6 +14,7 @@
 #include <sched.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
@@ -232,6 +233,16 @@ int ListShm(const char* prefix, char* first, size_t cap) {
   }
   closedir(d);
   return count;
+}
+
+bool StderrIsJournal() {
+  const char* stream = getenv("JOURNAL_STREAM");
+  unsigned long long dev = 0, ino = 0;
+  char end = 0;
+  if (!stream || sscanf(stream, "%llu:%llu%c", &dev, &ino, &end) != 2) return false;
+  struct stat st;
+  if (fstat(STDERR_FILENO, &st) != 0) return false;
+  return static_cast<unsigned long long>(st.st_dev) == dev && static_cast<unsigned long long>(st.st_ino) == ino;
 }
 
 }  // namespace platform

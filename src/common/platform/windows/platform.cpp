@@ -498,5 +498,7 @@ bool ParseIpv4(const char* text, uint32_t* network_order) {
 
 int NamedGroupId(const char* /*name*/) { return -1; }
 
+bool StderrIsJournal() { return false; }  // no journald: the service logs to a file
+
 }  // namespace platform
 }  // namespace ccomm

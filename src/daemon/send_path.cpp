@@ -23,7 +23,15 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
   idle_sleep_ns_ = watchdog_ns && watchdog_ns / 4 < heartbeat_ns_ ? watchdog_ns / 4 : heartbeat_ns_;
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   const bool multicast = table_.multicast();
+  // A reload (same nodes): each stream's frame numbers go on where they were, so the
+  // peers count no loss and see no restart.
+  std::vector<uint32_t> seqs;
+  if (peers_tx_.size() == m + 1)
+    for (const PeerTx& p : peers_tx_) seqs.push_back(p.seq);
   peers_tx_ = std::vector<PeerTx>(m + 1);  // + the group stream
+  for (size_t p = 0; p < seqs.size(); ++p) peers_tx_[p].seq = seqs[p];
+  periodic_.clear();
+  senders_.clear();
   group_tx_ = static_cast<uint32_t>(m);
   consumers_.assign(n, {});
   for (size_t i = 0; i < n; ++i) {
@@ -73,10 +81,15 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
   return 0;
 }
 
-void SendPath::Prepare(bool adopted) {
+void SendPath::Prepare(bool adopted, bool keep_sequences) {
   adopted_ = adopted;
   prepared_ = table_.signals();
   const uint32_t n = segment_.signal_count();
+  // A reload that kept the segment: each state's last value sent stays known, so values
+  // written while the threads were stopped still leave (CatchUp) or count as coalesced.
+  std::vector<uint64_t> last_sent;
+  if (keep_sequences && tx_signals_.size() == n)
+    for (const TxSignal& t : tx_signals_) last_sent.push_back(t.last_seq);
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
   collected_states_.assign(n, 0);  // RunTx never allocates: a state is taken at most once a round
@@ -94,6 +107,7 @@ void SendPath::Prepare(bool adopted) {
     if (!ps.forwarded) continue;
     if (!ps.is_event) tx_state_[id] = segment_.state(id);
     TxSignal& t = tx_signals_[id];
+    if (!last_sent.empty()) t.last_seq = last_sent[id];
     t.state = tx_state_[id];
     t.prefix = ps.prefix;
     t.tx = &segment_.stats(id).tx;

@@ -155,8 +155,8 @@ struct IoThreads {
 };
 
 #ifndef _WIN32
-// SIGUSR2 interrupts an I/O thread's blocking call (the receive thread waits in its socket
-// up to recv_timeout_ms): both loops treat EINTR as "nothing yet" and look at `running`.
+// SIGUSR2 interrupts the receive thread's blocking call (it waits in its socket up to
+// recv_timeout_ms): its loop treats EINTR as "nothing yet" and looks at `running`.
 void Interrupted(int) {}
 #endif
 
@@ -207,11 +207,13 @@ void JoinInterrupting(pthread_t t) {
 }
 
 // Stops the I/O threads for a stop or a reload: at once, not after the receive thread's
-// socket timeout (the pause a reload makes: docs/usage.md, "Reload").
+// socket timeout (the pause a reload makes: docs/usage.md, "Reload"). The send thread is
+// woken by RequestStop's doorbell and not interrupted: a signal in its sendto would drop
+// a frame whose values already count as sent.
 void StopIo(ccomm::Daemon& daemon, IoThreads* io) {
   daemon.RequestStop();
   if (!io->running) return;
-  JoinInterrupting(io->tx);
+  pthread_join(io->tx, nullptr);
   JoinInterrupting(io->rx);
   io->running = false;
 }

@@ -205,6 +205,7 @@ void SendPath::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   if (!periodic) {
     collected_states_[collected_count_++] = id;  // at most once per signal and round
     const uint64_t last = s.last_seq;
+    if (__builtin_expect(m.value_seq <= last, 0)) return;  // sent already: see CollectSignalSlow
     if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0))  // as in CollectSignalSlow
       CatchUpAndCount(id, last, m.value_seq, now);
   }
@@ -268,6 +269,11 @@ void SendPath::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   store::MarkStateForwarded(sv, version);
   if (!periodic) collected_states_[collected_count_++] = id;  // at most once per signal and round
   uint64_t& last = tx_signals_[id].last_seq;
+  // Sent already: the read may return the inline copy of a value whose writer has not
+  // raised `latest` yet (state_slot.h), so `forwarded` stays one behind it and the next
+  // round finds the same value again (also the first round after a reload, which keeps
+  // last_seq: Prepare). A state's values only grow in number within a segment.
+  if (!periodic && m.value_seq <= last) return;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
   if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {

@@ -31,7 +31,7 @@ NEW_SIGNAL = CONFIG.replace("</ccomm>", '  <signal name="z" type="double" produc
 # Both apps follow a segment replacement as an application should: on CCOMM_E_RETIRED
 # close, reopen (retrying while ccommd sets the new one up) and find the signal again.
 APP = r"""
-import ctypes, json, sys, time
+import ctypes, json, select, sys, time
 lib = ctypes.CDLL(sys.argv[1])
 role, node, seconds = sys.argv[2], sys.argv[3].encode(), float(sys.argv[4])
 class Info(ctypes.Structure):
@@ -59,10 +59,15 @@ if role == "writer":  # value 1 alone, until the test has seen it arrive (_write
     lib.ccomm_write_double(h, s, v)
     print("first", flush=True)
     sys.stdin.readline()
+# At least `seconds`, and until stdin closes (_result): the test decides when it has seen enough.
 end = time.time() + seconds
+told = False
 last = None
 v_out, info = ctypes.c_double(), Info()
-while time.time() < end:
+while True:
+    told = told or bool(select.select([sys.stdin], [], [], 0)[0] and not sys.stdin.readline())
+    if told and time.time() >= end:
+        break
     if role == "writer":
         v += 1.0
         r = lib.ccomm_write_double(h, s, v)
@@ -110,6 +115,7 @@ def _writer(pair, seconds):
 
 
 def _result(proc):
+    """Ends the app (its stdin closed; it runs at least its `seconds`): what it saw."""
     out, err = proc.communicate(timeout=30)
     assert proc.returncode == 0, err
     return json.loads(out.splitlines()[-1])
@@ -247,6 +253,7 @@ def test_reload_with_a_signal_change_replaces_the_segment_without_old_values(tmp
         t_control = time.time()
         rc, out = _reload(pair, "control")
         assert rc == 0, out + pair.log("control")
+        time.sleep(1.0)  # the apps run on at least this long in the new configuration (slow reloads: TSan)
         w, r = _result(writer), _result(reader)
         wrong_hash = pair.stats("planner")["counters"] if "counters" in pair.stats("planner") else None
         logs = {n: pair.log(n) for n in ("control", "planner")}

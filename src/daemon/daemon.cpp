@@ -37,6 +37,7 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
 
   // Shared memory: group "ccomm" if it exists, so members can use it (mode 0660).
   const int gid = platform::NamedGroupId("ccomm");
+  gid_ = gid;
   // Two ccommd for one node would both forward and reclaim in one segment: refuse the
   // second (a systemd unit and a hand-started one, say) before it touches anything.
   int holder = 0;

@@ -3,7 +3,8 @@
 // woken by the shared-memory doorbell or its periodic/heartbeat deadline), a receive part
 // (receive_path.h, the receive thread, blocked in the socket) and supervision
 // (supervisor.h, a tick on the main thread), each owning its state, over one
-// prepared-signals table built in Start() and constant afterwards (prepared_signals.h);
+// prepared-signals table built in Start() and constant while the I/O threads run (a reload
+// builds it again with them stopped: daemon_reload.cpp; prepared_signals.h);
 // what the threads hand each other is in thread_handoffs.h. Daemon owns what they share
 // (the segment, the transport, the frame key, the system view) and starts them.
 // Everything is allocated in Start(); the three loops never allocate (test_alloc.py).
@@ -62,6 +63,21 @@ class Daemon {
     handoffs_.PublishSelfClock(synced, realtime_offset_ns);
   }
   void RequestStop();
+
+  // Reload (daemon_reload.cpp; docs/usage.md, "Reload"), on the main thread in two steps.
+  /// Step 1, with the I/O threads running: "" if `next` can replace the running
+  /// configuration in this process, else why not, as "FILE:LINE: error: ..." lines: what
+  /// the open socket, the send cycle and the key were set up from at start stays (a
+  /// restart applies those).
+  std::string ReloadRefusal(const SystemConfig& next, uint32_t node_id) const;
+  /// Step 2, with the I/O threads stopped (RequestStop, both joined): every part set up
+  /// again from `next` over the open transport, as Start would, and running again for new
+  /// I/O threads. The segment is re-adopted when a restart would re-adopt it (same
+  /// layout: values and queued events stay, sequence numbers go on), else replaced (the
+  /// old one retired, as at a restart). 0, or -errno with `error`: then nothing runs
+  /// until a Reconfigure with the old configuration succeeds. `next` must outlive its use.
+  int Reconfigure(const SystemConfig& next, uint32_t node_id, std::string* error);
+
   /// Detaches from the segment (which stays for the clients: their values go stale).
   void Shutdown();
 
@@ -82,6 +98,7 @@ class Daemon {
   // What the parts share, set up in Start() (the parts hold references).
   store::Segment segment_;
   int lock_fd_ = -1;  // the node's lock (LockNode), held while this ccommd lives
+  int gid_ = -1;      // group "ccomm" of the segment and the view, or -1
   bool adopted_ = false;
   Transport transport_;
   auth::FrameAuth auth_;                   // per-frame MAC (off unless auth_key_file is set)

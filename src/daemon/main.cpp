@@ -4,13 +4,16 @@
 #include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #ifndef _WIN32
 #include <sys/stat.h>
 #endif
 
+#include <memory>
 #include <string>
 
 #include "common/platform.h"
@@ -61,6 +64,10 @@ const char kUsage[] =
     "                        second (default: <clock socket=>, else /var/run/ptp4l; 'none':\n"
     "                        not asked, state none)\n"
     "      --clock-config    print ptp4l's configuration for this node from <clock>; exit\n"
+    "      --reload PID      check the file as --check does; if valid, ask the ccommd PID to\n"
+    "                        reload it and wait for the result (systemctl reload: ExecReload=);\n"
+    "                        exit 0 applied, 1 invalid file or not applied (ccommd keeps running\n"
+    "                        on the configuration it had; its log says why)\n"
     "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
     "  -q, --quiet           warnings and errors only\n"
     "  -h, --help            this text\n"
@@ -70,6 +77,7 @@ const char kUsage[] =
     "CAP_SYS_NICE for SCHED_FIFO (<realtime priority=\"..\"/>); without them ccommd says so and\n"
     "carries on where it can (without RT), or fails with what to do (raw sockets).\n"
     "Environment: CCOMM_SHM_PREFIX (default \"/ccomm.\") names the segment /ccomm.NODE.\n"
+    "Signals: SIGTERM/SIGINT stop; SIGHUP reloads the file (docs/usage.md, \"Reload\").\n"
     "Exit status: 0 clean stop or valid config, 1 invalid config, 2 usage, 3 start-up failure.\n"
     "See ccommd(8), docs/config.md and docs/protocol.md.\n";
 
@@ -140,6 +148,139 @@ void* RxThread(void* d) {
   return nullptr;
 }
 
+// The I/O threads, started after Daemon::Start and again after each reload.
+struct IoThreads {
+  pthread_t tx{}, rx{};
+  bool running = false;
+};
+
+#ifndef _WIN32
+// SIGUSR2 interrupts the receive thread's blocking call (it waits in its socket up to
+// recv_timeout_ms): its loop treats EINTR as "nothing yet" and looks at `running`.
+void Interrupted(int) {}
+#endif
+
+int StartIo(ccomm::Daemon& daemon, IoThreads* io) {
+  using namespace ccomm;
+#ifndef _WIN32
+  static bool handler_installed = false;
+  if (!handler_installed) {
+    struct sigaction sa = {};
+    sa.sa_handler = Interrupted;  // no SA_RESTART: the blocking call returns EINTR
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR2, &sa, nullptr);
+    handler_installed = true;
+  }
+#endif
+  if (int e = pthread_create(&io->tx, nullptr, TxThread, &daemon)) {
+    Log(LogLevel::kError, "ccommd: cannot start the send thread: %s", strerror(e));
+    return e;
+  }
+  if (int e = pthread_create(&io->rx, nullptr, RxThread, &daemon)) {
+    Log(LogLevel::kError, "ccommd: cannot start the receive thread: %s", strerror(e));
+    daemon.RequestStop();
+    pthread_join(io->tx, nullptr);
+    return e;
+  }
+  io->running = true;
+  return 0;
+}
+
+// Joins `t`, interrupting it every millisecond meanwhile: a signal that came while the
+// thread was between blocking calls would be missed, and one more costs nothing.
+void JoinInterrupting(pthread_t t) {
+#ifdef _WIN32
+  pthread_join(t, nullptr);  // no reload there (stop_request_windows.cpp): a stop may wait
+#else
+  for (;;) {
+    pthread_kill(t, SIGUSR2);
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    ts.tv_nsec += 1000 * 1000;
+    if (ts.tv_nsec >= 1000000000L) {
+      ts.tv_sec += 1;
+      ts.tv_nsec -= 1000000000L;
+    }
+    if (pthread_timedjoin_np(t, nullptr, &ts) == 0) return;
+  }
+#endif
+}
+
+// Stops the I/O threads for a stop or a reload: at once, not after the receive thread's
+// socket timeout (the pause a reload makes: docs/usage.md, "Reload"). The send thread is
+// woken by RequestStop's doorbell and not interrupted: a signal in its sendto would drop
+// a frame whose values already count as sent.
+void StopIo(ccomm::Daemon& daemon, IoThreads* io) {
+  daemon.RequestStop();
+  if (!io->running) return;
+  pthread_join(io->tx, nullptr);
+  JoinInterrupting(io->rx);
+  io->running = false;
+}
+
+std::string FirstLine(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+enum class ReloadOutcome { kApplied, kRefused, kBroken };
+
+// SIGHUP (docs/usage.md, "Reload"): the file read and checked by the one parser while the
+// I/O threads go on with the running configuration; only a file that can be applied stops
+// them, for as long as Daemon::Reconfigure takes. kBroken: neither the new nor the old
+// configuration could be set up again (exit 3: systemd restarts ccommd).
+ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
+                     std::unique_ptr<ccomm::SystemConfig>* cfg, uint32_t* node, IoThreads* io) {
+  using namespace ccomm;
+  const int requester = stop::ReloadRequester();
+  sd::NotifyReloading();
+  Log(LogLevel::kNotice, "reload: reading %s", opt.config_path.c_str());
+  auto next = std::unique_ptr<SystemConfig>(new SystemConfig);
+  std::string error;
+  auto refuse = [&](const std::string& why) {
+    LogText(LogLevel::kError, why);
+    Log(LogLevel::kError, "reload failed: still forwarding on the configuration loaded before (hash %08x)",
+        (*cfg)->hash);
+    const std::string status = "forwarding on the old configuration; reload failed: " + FirstLine(why);
+    sd::NotifyReloaded(status.c_str());
+    stop::AnswerReload(requester, false);
+    return ReloadOutcome::kRefused;
+  };
+  if (!LoadConfig(opt.config_path, next.get(), &error)) return refuse(error);
+  const int n = next->FindNode(opt.node);
+  if (n < 0)
+    return refuse(opt.config_path + ": error: this board's node '" + opt.node +
+                  "' is not in the file any more (restart ccommd to be another node)");
+  const std::string why = daemon.ReloadRefusal(*next, static_cast<uint32_t>(n));
+  if (!why.empty()) return refuse(why);
+  const std::string fit = SegmentFitProblem(*next, static_cast<uint32_t>(n), store::SegmentName(opt.node));
+  if (!fit.empty()) return refuse(opt.config_path + ": error: " + fit);
+
+  const uint64_t t0 = platform::MonotonicNs();
+  StopIo(daemon, io);
+  int r = daemon.Reconfigure(*next, static_cast<uint32_t>(n), &error);
+  if (r != 0) {
+    const std::string failed = error;
+    Log(LogLevel::kError, "reload: %s; setting the configuration before up again", failed.c_str());
+    error.clear();
+    if (daemon.Reconfigure(**cfg, *node, &error) != 0 || StartIo(daemon, io) != 0) {
+      Log(LogLevel::kError, "reload: cannot set the configuration before up again either (%s): exiting",
+          error.c_str());
+      return ReloadOutcome::kBroken;
+    }
+    return refuse(opt.config_path + ": error: " + failed);
+  }
+  if (StartIo(daemon, io) != 0) return ReloadOutcome::kBroken;
+  const double paused_ms = static_cast<double>(platform::MonotonicNs() - t0) / 1e6;
+  const bool signals_changed = next->hash != (*cfg)->hash;
+  Log(LogLevel::kNotice, "reloaded %s: %zu signals, config hash %08x%s; segment %s; forwarding paused %.1f ms",
+      opt.config_path.c_str(), next->signals.size(), next->hash, signals_changed ? " (changed)" : " (same)",
+      daemon.adopted_segment() ? "kept (same layout)" : "replaced (the old one retired: applications reopen)",
+      paused_ms);
+  cfg->swap(next);  // the parts now read *cfg; the old configuration goes
+  *node = static_cast<uint32_t>(n);
+  sd::NotifyReloaded("forwarding");
+  stop::AnswerReload(requester, true);
+  return ReloadOutcome::kApplied;
+}
+
 }  // namespace
 
 // The daemon; main() runs it, as a Windows service with --service (service.h).
@@ -157,8 +298,10 @@ int RunDaemon(int argc, char** argv) {
       {"board-net", no_argument, nullptr, 'B'}, {"dry-run", no_argument, nullptr, 'D'},
       {"network-dir", required_argument, nullptr, 'N'},
       {"ptp-socket", required_argument, nullptr, 'P'}, {"clock-config", no_argument, nullptr, 'K'},
+      {"reload", required_argument, nullptr, 'L'},
       {nullptr, 0, nullptr, 0}};
   bool json = false, board_net = false, dry_run = false;
+  int reload_pid = 0;
   std::string network_dir = "/run/systemd/network";
   bool network_dir_given = false;
   // Under systemd every line gets its priority, also a usage error's (journalctl -p err).
@@ -189,6 +332,13 @@ int RunDaemon(int argc, char** argv) {
       case 'K': opt.clock_config = true; break;
       case 'W': opt.which_node = true; break;
       case 'J': json = true; break;
+      case 'L':
+        reload_pid = atoi(optarg);
+        if (reload_pid <= 0) {
+          Log(LogLevel::kError, "ccommd: --reload takes the pid of the running ccommd, not '%s'", optarg);
+          return 2;
+        }
+        break;
       case 'B': board_net = true; break;
       case 'D': dry_run = true; break;
       case 'N':
@@ -215,6 +365,10 @@ int RunDaemon(int argc, char** argv) {
     Log(LogLevel::kError, "ccommd: --dry-run goes with --board-net");
     return 2;
   }
+  if (reload_pid && (board_net || opt.check_only || opt.which_node || opt.clock_config)) {
+    Log(LogLevel::kError, "ccommd: --reload goes with none of --board-net, --check, --which-node, --clock-config");
+    return 2;
+  }
   if (board_net && (opt.check_only || opt.which_node || opt.clock_config)) {
     Log(LogLevel::kError, "ccommd: --board-net goes with none of --check, --which-node, --clock-config");
     return 2;
@@ -226,11 +380,30 @@ int RunDaemon(int argc, char** argv) {
   }
   SetLogVerbosity(static_cast<LogLevel>(verbosity));
 
-  SystemConfig cfg;
+  // The configuration in use; a reload replaces it (Reload above).
+  std::unique_ptr<SystemConfig> cfg_owner(new SystemConfig);
+  SystemConfig& cfg = *cfg_owner;
   std::string error;
   if (!LoadConfig(opt.config_path, &cfg, &error)) {
-    // Each FILE:LINE line at error priority: these are why the service failed.
+    // Each FILE:LINE line at error priority: these are why the service (or the reload) failed.
     LogText(LogLevel::kError, error);
+    if (reload_pid)  // ExecReload=
+      Log(LogLevel::kError, "not reloaded: ccommd (pid %d) keeps running on the configuration it has", reload_pid);
+    return 1;
+  }
+  if (reload_pid) {
+    // Valid here; the daemon reads and checks it again (the file it uses) and answers.
+    const int r = stop::AskReload(reload_pid, 30000);
+    if (r == 1) {
+      Log(LogLevel::kInfo, "ccommd (pid %d) reloaded %s", reload_pid, opt.config_path.c_str());
+      return 0;
+    }
+    if (r == 0)
+      Log(LogLevel::kError, "ccommd (pid %d) did not apply %s and keeps running on the configuration it had: "
+          "its log says why", reload_pid, opt.config_path.c_str());
+    else
+      Log(LogLevel::kError, "cannot ask ccommd (pid %d) to reload: %s", reload_pid,
+          r == -ETIMEDOUT ? "no answer within 30 s" : strerror(-r));
     return 1;
   }
   if (opt.check_only && json) {
@@ -344,18 +517,10 @@ int RunDaemon(int argc, char** argv) {
   if (r != 0) Log(LogLevel::kWarning, "cannot drop capabilities: %s", strerror(-r));
   else Log(LogLevel::kInfo, "%s", privileges.c_str());
 
-  pthread_t tx, rx;
-  if (int e = pthread_create(&tx, nullptr, TxThread, &daemon)) {
-    Log(LogLevel::kError, "ccommd: cannot start the send thread: %s", strerror(e));
-    return 3;
-  }
-  if (int e = pthread_create(&rx, nullptr, RxThread, &daemon)) {
-    Log(LogLevel::kError, "ccommd: cannot start the receive thread: %s", strerror(e));
-    daemon.RequestStop();
-    pthread_join(tx, nullptr);
-    return 3;
-  }
+  IoThreads io;
+  if (StartIo(daemon, &io) != 0) return 3;
   sd::NotifyReady();
+  uint32_t node_id = static_cast<uint32_t>(node);
   if (ccomm_steady_state_begin) ccomm_steady_state_begin();
 
   const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
@@ -363,7 +528,10 @@ int RunDaemon(int argc, char** argv) {
   for (;;) {
     const stop::Request req = stop::Wait(10);
     if (req == stop::Request::kStop) break;
-    if (req == stop::Request::kReload) Log(LogLevel::kNotice, "SIGHUP ignored: restart ccommd to load a new configuration");
+    if (req == stop::Request::kReload && Reload(daemon, opt, &cfg_owner, &node_id, &io) == ReloadOutcome::kBroken) {
+      daemon.Shutdown();
+      return 3;
+    }
     uint64_t now = platform::MonotonicNs();
     daemon.Supervise(now);
     // Ping the watchdog only while both I/O loops make progress.
@@ -378,9 +546,7 @@ int RunDaemon(int argc, char** argv) {
   if (ccomm_steady_state_end) ccomm_steady_state_end();
   sd::NotifyStopping();
   Log(LogLevel::kInfo, "stopping");
-  daemon.RequestStop();
-  pthread_join(tx, nullptr);
-  pthread_join(rx, nullptr);
+  StopIo(daemon, &io);
   daemon.Shutdown();
   return 0;
 }

@@ -24,16 +24,34 @@ constexpr int32_t kResyncDistance = 1024;
 
 }  // namespace
 
-void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind kind, int recv_timeout_ms) {
+void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind kind, int recv_timeout_ms,
+                          bool keep_sequences) {
   cfg_ = &cfg;
   self_ = self;
   recv_timeout_ms_ = recv_timeout_ms;
   peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
   const uint32_t n = segment_.signal_count(), m = static_cast<uint32_t>(cfg.nodes.size());
+  keep_sequences = keep_sequences && peers_rx_.size() == m && rx_signals_.size() == n;
+  std::vector<PeerRx> old_peers;
+  std::vector<auth::ReplayWindow> old_replay;
+  std::vector<SignalRx> old_last;
+  if (keep_sequences) {
+    old_peers.swap(peers_rx_);
+    old_replay.swap(replay_);
+    for (const RxSignal& r : rx_signals_) old_last.push_back(r.last);
+  }
   peers_rx_.assign(m, PeerRx());
   // A floor no frame bears out stands one heartbeat interval at most (peer_clock.h).
   for (PeerRx& pr : peers_rx_) pr.clock.set_confirm_window_ns(uint64_t{cfg.network.heartbeat_ms} * 1000000);
   replay_.assign(m, auth::ReplayWindow());
+  if (keep_sequences) {
+    for (uint32_t p = 0; p < m; ++p) {
+      peers_rx_[p] = old_peers[p];
+      peers_rx_[p].ipv4 = 0;  // from this configuration, below
+    }
+    replay_.swap(old_replay);
+  }
+  any_by_production_ = false;
   for (uint32_t p = 0; p < m; ++p) {
     // UDP frames must come from the peer's own address (rule 2); raw frames carry no
     // address worth checking (any station can send any source MAC).
@@ -71,6 +89,7 @@ void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind 
     if (ps.is_event) r.ring = segment_.ring(id);
     else r.state = segment_.state(id);
     r.stats = &segment_.stats(id);
+    if (keep_sequences) r.last = old_last[id];
   }
 }
 

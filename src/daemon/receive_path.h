@@ -36,7 +36,11 @@ class ReceivePath {
   /// records, reassembly buffers, per-peer sequence state; UDP frames of a peer must come
   /// from its configured address (transport `kind`). `recv_timeout_ms`: how long a
   /// local-only node's loop sleeps per turn.
-  void Prepare(const SystemConfig& cfg, uint32_t self, TransportKind kind, int recv_timeout_ms);
+  /// `keep_sequences` (a reload that re-adopted the segment, same nodes and signals): the
+  /// peers' frame streams, clocks, replay windows and each signal's last applied value
+  /// carry over, so a reload neither counts losses nor lets an old value in again.
+  void Prepare(const SystemConfig& cfg, uint32_t self, TransportKind kind, int recv_timeout_ms,
+               bool keep_sequences = false);
   /// The receive thread's body; returns once ThreadHandoffs::running is false.
   void RunRx();
 

@@ -9,6 +9,11 @@ namespace ccomm {
 namespace sd {
 
 void NotifyReady();
+/// A reload begins (RELOADING=1 with MONOTONIC_USEC, which systemd >= 253 asks for); it
+/// ends with NotifyReloaded.
+void NotifyReloading();
+/// A reload ended: READY=1 and `status` as the unit's status line (systemctl status).
+void NotifyReloaded(const char* status);
 void NotifyStopping();
 void NotifyWatchdog();
 /// Watchdog interval asked for by the unit (WatchdogSec=), 0 if none.

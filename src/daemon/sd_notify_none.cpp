@@ -6,6 +6,8 @@ namespace ccomm {
 namespace sd {
 
 void NotifyReady() {}
+void NotifyReloading() {}
+void NotifyReloaded(const char*) {}
 void NotifyStopping() {}
 void NotifyWatchdog() {}
 uint64_t WatchdogIntervalNs() { return 0; }

@@ -23,7 +23,15 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
   idle_sleep_ns_ = watchdog_ns && watchdog_ns / 4 < heartbeat_ns_ ? watchdog_ns / 4 : heartbeat_ns_;
   const size_t n = cfg.signals.size(), m = cfg.nodes.size();
   const bool multicast = table_.multicast();
+  // A reload (same nodes): each stream's frame numbers go on where they were, so the
+  // peers count no loss and see no restart.
+  std::vector<uint32_t> seqs;
+  if (peers_tx_.size() == m + 1)
+    for (const PeerTx& p : peers_tx_) seqs.push_back(p.seq);
   peers_tx_ = std::vector<PeerTx>(m + 1);  // + the group stream
+  for (size_t p = 0; p < seqs.size(); ++p) peers_tx_[p].seq = seqs[p];
+  periodic_.clear();
+  senders_.clear();
   group_tx_ = static_cast<uint32_t>(m);
   consumers_.assign(n, {});
   for (size_t i = 0; i < n; ++i) {
@@ -73,10 +81,15 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
   return 0;
 }
 
-void SendPath::Prepare(bool adopted) {
+void SendPath::Prepare(bool adopted, bool keep_sequences) {
   adopted_ = adopted;
   prepared_ = table_.signals();
   const uint32_t n = segment_.signal_count();
+  // A reload that kept the segment: each state's last value sent stays known, so values
+  // written while the threads were stopped still leave (CatchUp) or count as coalesced.
+  std::vector<uint64_t> last_sent;
+  if (keep_sequences && tx_signals_.size() == n)
+    for (const TxSignal& t : tx_signals_) last_sent.push_back(t.last_seq);
   due_ns_.assign(n, 0);
   fwd_cursors_.assign(n, store::RingCursor());
   step_states_.clear();
@@ -94,6 +107,7 @@ void SendPath::Prepare(bool adopted) {
     if (!ps.forwarded) continue;
     if (!ps.is_event) tx_state_[id] = segment_.state(id);
     TxSignal& t = tx_signals_[id];
+    if (!last_sent.empty()) t.last_seq = last_sent[id];
     t.state = tx_state_[id];
     t.prefix = ps.prefix;
     t.tx = &segment_.stats(id).tx;
@@ -197,6 +211,7 @@ void SendPath::CollectSignal(uint32_t id, uint64_t now, bool periodic) {
   store::MarkStateForwarded(sv, version);
   if (!periodic) {
     const uint64_t last = s.last_seq;
+    if (__builtin_expect(m.value_seq <= last, 0)) return;  // sent already: see CollectSignalSlow
     // Behind the writer: the value goes out after the round's loop, with the older ones
     // still in its slots (send_catch_up.cpp). As in CollectSignalSlow.
     if (__builtin_expect(m.value_seq > last + 1 && (last || !adopted_), 0)) return DeferCatchUp(id);
@@ -254,6 +269,11 @@ void SendPath::CollectSignalSlow(uint32_t id, uint64_t now, bool periodic) {
   if (r != store::StoreResult::kOk) return;  // a damaged copy is never forwarded
   store::MarkStateForwarded(sv, version);
   uint64_t& last = tx_signals_[id].last_seq;
+  // Sent already: the read may return the inline copy of a value whose writer has not
+  // raised `latest` yet (state_slot.h), so `forwarded` stays one behind it and the next
+  // round finds the same value again (also the first round after a reload, which keeps
+  // last_seq: Prepare). A state's values only grow in number within a segment.
+  if (!periodic && m.value_seq <= last) return;
   // Values are numbered from 1 in a segment this ccommd created, so values replaced before
   // the first one sent count too; after re-adoption the predecessor is unknown.
   if (!periodic && (last || !adopted_) && m.value_seq > last + 1) {

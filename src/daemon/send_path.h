@@ -39,7 +39,9 @@ class SendPath {
                   std::vector<PeerAddress>* groups, std::string* error);
   /// Start-up, once the segment exists and the table is resolved: the signals' send
   /// records, event cursors (resumed in a re-adopted segment), buffers.
-  void Prepare(bool adopted);
+  /// `keep_sequences`: a reload that re-adopted the segment with the same signals; what
+  /// was last sent of each signal carries over (Daemon::Reconfigure).
+  void Prepare(bool adopted, bool keep_sequences = false);
   /// Last of start-up: the periodic signals are due from `now` on.
   void StartPeriods(uint64_t now);
   /// Send on the cycle (send_cycle_daemon.cpp), start-up after the transport is open and

@@ -2,7 +2,8 @@
 # ccommd's library sources, for the Linux build (daemon/CMakeLists.txt) and the Windows
 # build (src/windows.cmake): the portable files, and per platform the whole files that
 # are its platform code (sockets, interfaces, privileges, key file, ptp4l, stop requests, service).
-set(CCOMM_DAEMON_SOURCES daemon.cpp prepared_signals.cpp send_path.cpp send_catch_up.cpp receive_path.cpp supervisor.cpp
+set(CCOMM_DAEMON_SOURCES daemon.cpp daemon_reload.cpp prepared_signals.cpp send_path.cpp send_catch_up.cpp receive_path.cpp
+    supervisor.cpp
     system_view_writer.cpp transport_address.cpp auth.cpp ptp_state.cpp ptp_config.cpp node_identity.cpp
     send_cycle.cpp send_cycle_daemon.cpp)
 set(CCOMM_DAEMON_POSIX_SOURCES transport_raw.cpp foreign_frames.cpp transport_udp.cpp node_interfaces_posix.cpp

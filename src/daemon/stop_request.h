@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// How ccommd is asked to stop (or to reload, which it refuses): signals on POSIX
-// (SIGTERM, SIGINT, SIGHUP; stop_request_posix.cpp), the console's Ctrl-C / Ctrl-Break /
+// How ccommd is asked to stop or to reload: signals on POSIX (SIGTERM, SIGINT, SIGHUP;
+// stop_request_posix.cpp; `ccommd --reload PID` sends its SIGHUP with sigqueue and waits
+// for the answer, so that systemctl reload fails when the reload did), the console's Ctrl-C / Ctrl-Break /
 // close and the service manager's stop on Windows (stop_request_windows.cpp). main()
 // waits for a request in its supervision loop.
 #pragma once
@@ -18,6 +19,16 @@ void Install();
 Request Wait(int timeout_ms);
 /// A stop request from inside the process (the Windows service's stop control).
 void RequestStop();
+
+/// The process that asked for the last kReload and waits for the answer (`ccommd
+/// --reload`), or 0 (a plain kill -HUP: nobody to answer).
+int ReloadRequester();
+/// Answers `requester` (from ReloadRequester): applied or not. Nothing if it is 0.
+void AnswerReload(int requester, bool applied);
+/// `ccommd --reload PID`: asks daemon `pid` to reload and waits up to `timeout_ms` for
+/// its answer. 1 applied, 0 refused (the daemon logged why), -errno if it could not ask
+/// or no answer came (-ETIMEDOUT).
+int AskReload(int pid, int timeout_ms);
 
 }  // namespace stop
 }  // namespace ccomm

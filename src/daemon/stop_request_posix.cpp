@@ -1,18 +1,30 @@
 // SPDX-License-Identifier: Apache-2.0
 // Stop requests on POSIX (stop_request.h): SIGTERM and SIGINT stop, SIGHUP asks for a
 // reload; the main thread takes them synchronously (sigtimedwait), the I/O threads block them.
+//
+// The reload answer: `ccommd --reload PID` sends SIGHUP by sigqueue with kReloadAsk as
+// its value and waits for SIGUSR1 from PID, whose value says applied (1) or not (0). Only
+// a SIGHUP carrying that value is answered: a plain kill -HUP's sender may be gone, and
+// SIGUSR1 would end whatever process has its pid now.
+#include <errno.h>
 #include <pthread.h>
 #include <signal.h>
+#include <string.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "common/platform.h"
 #include "daemon/stop_request.h"
 
 namespace ccomm {
 namespace stop {
 namespace {
 
+constexpr int kReloadAsk = 0x43524c44;  // "CRLD"
+constexpr int kAnswerSignal = SIGUSR1;
+
 sigset_t g_set;
+int g_requester = 0;
 
 }  // namespace
 
@@ -26,13 +38,49 @@ void Install() {
 
 Request Wait(int timeout_ms) {
   struct timespec ts = {timeout_ms / 1000, (timeout_ms % 1000) * 1000L * 1000L};
-  const int sig = sigtimedwait(&g_set, nullptr, &ts);
+  siginfo_t info = {};
+  const int sig = sigtimedwait(&g_set, &info, &ts);
   if (sig == SIGTERM || sig == SIGINT) return Request::kStop;
-  if (sig == SIGHUP) return Request::kReload;
+  if (sig == SIGHUP) {
+    g_requester = info.si_code == SI_QUEUE && info.si_value.sival_int == kReloadAsk ? info.si_pid : 0;
+    return Request::kReload;
+  }
   return Request::kNone;
 }
 
 void RequestStop() { kill(getpid(), SIGTERM); }
+
+int ReloadRequester() { return g_requester; }
+
+void AnswerReload(int requester, bool applied) {
+  if (requester <= 0) return;
+  union sigval v;
+  v.sival_int = applied ? 1 : 0;
+  if (sigqueue(requester, kAnswerSignal, v) != 0)
+    Log(LogLevel::kWarning, "cannot answer the reload request of pid %d: %s", requester, strerror(errno));
+}
+
+int AskReload(int pid, int timeout_ms) {
+  // Blocked before asking: the answer may come before sigtimedwait runs.
+  sigset_t answer;
+  sigemptyset(&answer);
+  sigaddset(&answer, kAnswerSignal);
+  pthread_sigmask(SIG_BLOCK, &answer, nullptr);
+  union sigval v;
+  v.sival_int = kReloadAsk;
+  if (sigqueue(pid, SIGHUP, v) != 0) return -errno;
+  const uint64_t deadline = platform::MonotonicNs() + uint64_t(timeout_ms) * 1000000;
+  for (;;) {
+    const uint64_t now = platform::MonotonicNs();
+    if (now >= deadline) return -ETIMEDOUT;
+    const uint64_t left = deadline - now;
+    struct timespec ts = {static_cast<time_t>(left / 1000000000), static_cast<long>(left % 1000000000)};
+    siginfo_t info = {};
+    const int sig = sigtimedwait(&answer, &info, &ts);
+    if (sig == kAnswerSignal && info.si_pid == pid) return info.si_value.sival_int == 1 ? 1 : 0;
+    if (sig < 0 && errno != EINTR && errno != EAGAIN) return -errno;
+  }
+}
 
 }  // namespace stop
 }  // namespace ccomm

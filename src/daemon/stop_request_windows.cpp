@@ -9,6 +9,8 @@
 #include <windows.h>
 // clang-format on
 
+#include <errno.h>
+
 #include <atomic>
 
 #include "daemon/stop_request.h"
@@ -53,6 +55,11 @@ void RequestStop() {
   g_stop.store(true);
   SetEvent(g_event);
 }
+
+// No reload on Windows (no SIGHUP): restart the service to load a new file.
+int ReloadRequester() { return 0; }
+void AnswerReload(int, bool) {}
+int AskReload(int, int) { return -ENOSYS; }
 
 }  // namespace stop
 }  // namespace ccomm

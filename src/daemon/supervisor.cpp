@@ -17,6 +17,7 @@ void Supervisor::Configure(const SystemConfig& cfg, uint32_t self, const std::st
   ptp_.Configure(ptp_socket, ptp_synced_within_ns, static_cast<uint8_t>(cfg.clock.domain));
   peer_timeout_ns_ = uint64_t{cfg.network.peer_timeout_ms} * 1000000;
   fresh_.assign(cfg.signals.size(), 0);
+  consumed_.clear();
   for (size_t i = 0; i < cfg.signals.size(); ++i) {
     const SignalConfig& s = cfg.signals[i];
     if (s.producer == self) continue;
@@ -28,10 +29,12 @@ void Supervisor::Configure(const SystemConfig& cfg, uint32_t self, const std::st
   }
 }
 
-void Supervisor::Prepare(bool adopted) {
+void Supervisor::Prepare(bool adopted, bool reload) {
   reclaim_suspects_.assign(store::SlotCount(segment_), store::SlotSuspect());
-  // A re-adopted segment's peers were alive for the previous ccommd.
-  for (uint32_t p = 0; p < table_.node_count(); ++p) segment_.peer(p).alive.store(0);
+  // A re-adopted segment's peers were alive for the previous ccommd; after a reload
+  // that kept the segment they are for this one, and stay as they are.
+  if (!(adopted && reload))
+    for (uint32_t p = 0; p < table_.node_count(); ++p) segment_.peer(p).alive.store(0);
   if (adopted) {
     // Writers that died while this ccommd was down may have left slots half-written.
     size_t freed = store::ReclaimAbandonedSlots(segment_, &reclaim_suspects_);

@@ -37,8 +37,9 @@ class Supervisor {
   void Configure(const SystemConfig& cfg, uint32_t self, const std::string& ptp_socket,
                  int64_t ptp_synced_within_ns);
   /// Start-up, once the segment exists: no peer alive yet; in a re-adopted segment, the
-  /// slots of writers that died while no ccommd ran are freed now.
-  void Prepare(bool adopted);
+  /// slots of writers that died while no ccommd ran are freed now. `reload`: set up
+  /// again by a reload (Daemon::Reconfigure), peers keep their liveness.
+  void Prepare(bool adopted, bool reload = false);
   /// Start-up, while ccommd still has its capabilities: the watch for frames of other
   /// transports or EtherTypes (CAP_NET_RAW); without it that is logged and left off.
   void WatchForeignFrames(const SystemConfig& cfg, uint32_t self, TransportKind kind);

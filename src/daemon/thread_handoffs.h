@@ -6,6 +6,10 @@
 // The other crossings have rules of their own: the segment (store/layout.h: the daemon
 // counters, per-signal and per-peer statistics, the doorbell) and the system view
 // (system_view_writer.h: one writer per node record).
+// A reload (daemon_reload.cpp) needs no field here: the main thread stops the send and
+// receive threads (running = false, joined), sets every part up again from the new
+// configuration, and starts new ones; pthread_join and pthread_create order all of that
+// before and after the loops, so the loops never check for a new configuration.
 #pragma once
 
 #include <atomic>

@@ -37,7 +37,9 @@ size_t StageStride(uint32_t value_bytes) { return (value_bytes + 7u) & ~size_t{7
 // active then). steps_active first: a step seen ended there has its steps_done raised
 // before (EndStep's order), so the second load sees it.
 bool StepsMoved(const store::SegmentHeader* h, uint32_t steps_at) {
+#ifndef CCOMM_TSAN  // TSan does not model fences (the loads below are acquire loads anyway)
   std::atomic_thread_fence(std::memory_order_acquire);  // after the copies this follows
+#endif
   if (h->steps_active.load(std::memory_order_acquire) != 0) return true;
   return h->steps_done.load(std::memory_order_acquire) != steps_at;
 }

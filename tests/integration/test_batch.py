@@ -10,7 +10,7 @@ import subprocess
 import sys
 import time
 
-from harness import BUILD, NodePair, python_env, signal_stats
+from harness import BUILD, SANITIZED, NodePair, python_env, signal_stats
 
 CONFIG = """<?xml version="1.0"?>
 <ccomm version="1">
@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def run_batch(tmp_path, cycles, pause_us, same_cpu=False):
-    """Runs batch_writer.py against control's ccommd; returns (frames, bA's stats)."""
+    """Runs batch_writer.py against control's ccommd; returns (frames, bA's stats, bB's)."""
     cfg = tmp_path / "batch.xml"
     cfg.write_text(CONFIG)
     with NodePair(config=str(cfg)) as pair:
@@ -49,7 +49,8 @@ def run_batch(tmp_path, cycles, pause_us, same_cpu=False):
         assert writer.returncode == 0, writer.stdout
         sink.communicate(timeout=30)
         frames = [json.loads(line) for line in open(tmp_path / "frames.jsonl")]
-        return frames, signal_stats(pair.stats("control"), "bA")
+        stats = pair.stats("control")
+        return frames, signal_stats(stats, "bA"), signal_stats(stats, "bB")
 
 
 def check_steps(frames, st, cycles):
@@ -79,7 +80,7 @@ def check_steps(frames, st, cycles):
 
 
 def test_batch_step_leaves_in_one_frame(tmp_path):
-    frames, st = run_batch(tmp_path, CYCLES, 1000)
+    frames, st, _ = run_batch(tmp_path, CYCLES, 1000)
     c_frames = check_steps(frames, st, CYCLES)
     assert c_frames >= CYCLES // 2, c_frames  # the other handle's doorbell did send mid-step
 
@@ -90,6 +91,15 @@ def test_batch_steps_stay_whole_when_ccommd_lags(tmp_path):
     frame could carry the oldest value of one signal of a step whose other signal that same
     step had already overwritten in its slots (CI, under load: 1 frame in 1000 steps)."""
     cycles = 20000
-    frames, st = run_batch(tmp_path, cycles, 0, same_cpu=True)
-    check_steps(frames, st, cycles)
+    frames, st, st_b = run_batch(tmp_path, cycles, 0, same_cpu=True)
     assert st["coalesced"] > 0, st  # ccommd did lag: the case under test happened
+    # Every value of each signal arrived once or is counted coalesced, sanitizer or not.
+    for name, stats, sig in (("bA", st, 0), ("bB", st_b, 1)):
+        got = [v for f in frames for s_, v in f["entries"] if s_ == sig]
+        assert len(got) == len(set(got)), name + ": a value sent twice"
+        assert len(got) + stats["coalesced"] == cycles, (name, len(got), stats["coalesced"], cycles)
+    # Whole steps hold while one send round takes less than 3 steps' time (a state keeps its
+    # last 4 values). Under a sanitizer a round is 10-50 times slower than the steps back to
+    # back here: a step may then be split, its missing values counted above (design.md).
+    if not SANITIZED:
+        check_steps(frames, st, cycles)

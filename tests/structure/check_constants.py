@@ -162,7 +162,7 @@ def python_binding(src, errors):
             c_names = re.findall(r"\bCCOMM_\w+", lines[line - 1].split("#", 1)[1]) \
                 if "#" in lines[line - 1] else []
             by_name = "CCOMM_" + name.lstrip("_")
-            if by_name in values:
+            if by_name in values and by_name not in c_names:
                 c_names.append(by_name)
             for c in c_names:
                 if c not in values:

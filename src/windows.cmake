@@ -59,15 +59,15 @@ install(TARGETS ccommd RUNTIME DESTINATION bin)
 # ccomm.exe, the command line tool, and ccomm-latency.exe, against ccomm.dll.
 set(_cli ${CMAKE_CURRENT_LIST_DIR}/cli)
 add_executable(ccomm_cli ${_cli}/main.cpp ${_cli}/stats.cpp ${_cli}/stats_all.cpp ${_cli}/values.cpp
-               ${_cli}/external_windows.cpp ${CMAKE_CURRENT_LIST_DIR}/tools/app_os_windows.cpp)
+               ${_cli}/external_windows.cpp)
 set_target_properties(ccomm_cli PROPERTIES OUTPUT_NAME ccomm)
 ccomm_core_target(ccomm_cli)
 target_compile_definitions(ccomm_cli PRIVATE CCOMM_DATADIR="share/ccomm")
-target_link_libraries(ccomm_cli PRIVATE ccomm ccomm_config)
+target_link_libraries(ccomm_cli PRIVATE ccomm ccomm_config ccomm_platform_app)
 install(TARGETS ccomm_cli RUNTIME DESTINATION bin)
-add_executable(ccomm-latency ${CMAKE_CURRENT_LIST_DIR}/tools/latency.cpp ${CMAKE_CURRENT_LIST_DIR}/tools/app_os_windows.cpp)
+add_executable(ccomm-latency ${CMAKE_CURRENT_LIST_DIR}/tools/latency.cpp)
 target_include_directories(ccomm-latency PRIVATE ${PROJECT_SOURCE_DIR}/src)
-target_link_libraries(ccomm-latency PRIVATE ccomm Threads::Threads)
+target_link_libraries(ccomm-latency PRIVATE ccomm ccomm_platform_app Threads::Threads)
 install(TARGETS ccomm-latency RUNTIME DESTINATION bin)
 
 # The unit tests that apply to a PC: the ones of the modules above that need no Linux

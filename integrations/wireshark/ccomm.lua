@@ -19,14 +19,22 @@
 
 local ccomm = Proto("ccomm", "ccomm signal frames")
 
-local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16
-local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46
-local MAGIC, VERSION = 0x43434D57, 2
-local F_HEARTBEAT, F_AUTH, F_SUMMARY, F_KNOWN = 0x01, 0x02, 0x04, 0x07
-local S_HEAD, S_RECORD, S_MAX = 80, 24, 56  -- node summary body (protocol.md "Node summary")
-local E_EVENT, E_FRAGMENT, E_KNOWN = 0x01, 0x02, 0x03
-local FRAGMENT_HEADER, MAX_FRAGMENTED = 8, 65536  -- fragment sub-header; largest fragmented value
-local DEST_ALL = 0xFFFF
+-- The wire format's constants, each with the C++ definition it copies (src/wire/wire.h,
+-- summary.h; tests/structure/check_constants.py holds them equal).
+local HEADER, ENTRY_HEADER, TAG_SIZE = 32, 24, 16  -- wire: kHeaderSize, kEntryHeaderSize, kAuthTagSize
+local MAX_FRAME, ETH_MIN_PAYLOAD = 1472, 46  -- wire: kMaxFrameSize, kEthMinPayload
+local MAGIC, VERSION = 0x43434D57, 2  -- wire: kMagic, kVersion
+local F_HEARTBEAT, F_AUTH, F_SUMMARY, F_KNOWN = 0x01, 0x02, 0x04, 0x07  -- wire: kFlagHeartbeat, kFlagAuth, kFlagSummary, kFlagHeartbeat | kFlagAuth | kFlagSummary
+-- node summary body (protocol.md "Node summary"): head, record, records per part
+local S_HEAD, S_RECORD, S_MAX = 80, 24, 56  -- wire: kSummaryHeadSize, kSummaryRecordSize, kSummaryMaxRecords
+local R_STALE, R_NEVER, R_KNOWN = 0x01, 0x02, 0x03  -- wire: kRecordStale, kRecordNever, kRecordStale | kRecordNever
+local CLOCK_STATES, NO_AGE = 4, 0xFFFFFFFF  -- wire: kSummaryClockStates, kSummaryNoAge
+local E_EVENT, E_FRAGMENT, E_KNOWN = 0x01, 0x02, 0x03  -- wire: kEntryEvent, kEntryFragment, kEntryEvent | kEntryFragment
+-- fragment sub-header; largest fragmented value
+local FRAGMENT_HEADER, MAX_FRAGMENTED = 8, 65536  -- wire: kFragmentHeaderSize, kMaxFragmentedValue
+local DEST_ALL = 0xFFFF  -- wire: kDestAll
+-- the preferences' defaults: those of <network> (src/config/config.h)
+local UDP_PORT, ETHERTYPE = 47800, 0x88B5  -- wire: udp_port, ethertype
 
 -- Builds with Lua 5.2 have bit32; with 5.3 or later, the operators instead (a syntax
 -- error for 5.2's parser, hence load()).
@@ -51,7 +59,7 @@ local f = {
   flag_heartbeat = ProtoField.bool("ccomm.flags.heartbeat", "heartbeat", 8, nil, F_HEARTBEAT),
   flag_auth = ProtoField.bool("ccomm.flags.auth", "authentication tag present", 8, nil, F_AUTH),
   flag_summary = ProtoField.bool("ccomm.flags.summary", "node summary", 8, nil, F_SUMMARY),
-  flag_unknown = ProtoField.uint8("ccomm.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xF8),
+  flag_unknown = ProtoField.uint8("ccomm.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFF - F_KNOWN),
   sender = ProtoField.uint16("ccomm.sender", "sender", base.DEC),
   config_hash = ProtoField.uint32("ccomm.config_hash", "config_hash", base.HEX),
   seq = ProtoField.uint32("ccomm.seq", "seq", base.DEC),
@@ -67,7 +75,8 @@ local f = {
   e_flag_event = ProtoField.bool("ccomm.entry.flags.event", "event (queued; clear: state)", 8, nil, E_EVENT),
   e_flag_fragment = ProtoField.bool("ccomm.entry.flags.fragment", "fragment (part of a large value)", 8, nil,
                                    E_FRAGMENT),
-  e_flag_unknown = ProtoField.uint8("ccomm.entry.flags.unknown", "unknown bits (must be 0)", base.HEX, nil, 0xFC),
+  e_flag_unknown = ProtoField.uint8("ccomm.entry.flags.unknown", "unknown bits (must be 0)", base.HEX, nil,
+                                  0xFF - E_KNOWN),
   e_total_len = ProtoField.uint32("ccomm.entry.total_len", "total_len (whole value)", base.DEC),
   e_offset = ProtoField.uint32("ccomm.entry.offset", "offset (of this part)", base.DEC),
   e_count = ProtoField.uint16("ccomm.entry.count", "count", base.DEC),
@@ -112,8 +121,8 @@ local f = {
   r_signal = ProtoField.uint16("ccomm.summary.record.signal", "signal", base.DEC),
   r_role = ProtoField.uint8("ccomm.summary.record.role", "role", base.DEC, { [1] = "producer", [2] = "consumer" }),
   r_flags = ProtoField.uint8("ccomm.summary.record.flags", "flags", base.HEX),
-  r_flag_stale = ProtoField.bool("ccomm.summary.record.flags.stale", "stale", 8, nil, 0x01),
-  r_flag_never = ProtoField.bool("ccomm.summary.record.flags.never", "never (no value yet)", 8, nil, 0x02),
+  r_flag_stale = ProtoField.bool("ccomm.summary.record.flags.stale", "stale", 8, nil, R_STALE),
+  r_flag_never = ProtoField.bool("ccomm.summary.record.flags.never", "never (no value yet)", 8, nil, R_NEVER),
   r_rate_mhz = ProtoField.uint32("ccomm.summary.record.rate_mhz", "rate_mhz (values/s x 1000)", base.DEC),
   r_lost = ProtoField.uint64("ccomm.summary.record.lost", "lost", base.DEC),
   r_age_ms = ProtoField.uint32("ccomm.summary.record.age_ms", "age_ms", base.DEC),
@@ -139,8 +148,8 @@ E.note = ProtoExpert.new("ccomm.note", "note", expert.group.COMMENTS_GROUP, expe
 ccomm.experts = { E.too_short, E.bad_magic, E.bad_version, E.bad_header, E.bad_entry,
                   E.trailing_bytes, E.bad_summary, E.bad_signal, E.config_mismatch, E.config_error, E.note }
 
-ccomm.prefs.udp_port = Pref.uint("UDP port", 47800, "UDP port of ccomm frames (<network udp_port=...>)")
-ccomm.prefs.ethertype = Pref.uint("EtherType", 0x88B5, "EtherType of raw ccomm frames (<network ethertype=...>)")
+ccomm.prefs.udp_port = Pref.uint("UDP port", UDP_PORT, "UDP port of ccomm frames (<network udp_port=...>)")
+ccomm.prefs.ethertype = Pref.uint("EtherType", ETHERTYPE, "EtherType of raw ccomm frames (<network ethertype=...>)")
 ccomm.prefs.config = Pref.string("Configuration (JSON)", "",
   "Output of ccommd --check signals.xml --json: names nodes and signals, checks entries against it")
 
@@ -304,7 +313,7 @@ local function dissect_entry(ctx, tvb, off, left, index, sender)
   local function fail(item, text) ok = false; bad(item, text) end
   if not t then fail(type_item, "unknown type " .. code) end
   if band(eflags, 0xFF - E_KNOWN) ~= 0 then
-    fail(flags_item, string.format("unknown entry flag bits 0x%02x", band(eflags, 0xFC)))
+    fail(flags_item, string.format("unknown entry flag bits 0x%02x", band(eflags, 0xFF - E_KNOWN)))
   end
   if count == 0 then fail(count_item, "count 0") end
   if tvb(off + 12, 4):uint() ~= 0 then fail(res_item, string.format("reserved not 0 (0x%08x)", tvb(off + 12, 4):uint())) end
@@ -378,7 +387,7 @@ local function dissect_summary(ctx, tvb, len, avail)
   if parts == 0 or part >= parts then bad(body, string.format("part not below parts (%d, %d)", part, parts)) end
   if n > S_MAX then bad(body, string.format("record_count above 56 (%d)", n)) end
   local clock_state = tvb(HEADER + 64, 1):uint()
-  if clock_state > 3 then bad(body, string.format("unknown clock_state (%d)", clock_state)) end
+  if clock_state >= CLOCK_STATES then bad(body, string.format("unknown clock_state (%d)", clock_state)) end
   if tvb(HEADER + 65, 3):uint() ~= 0 then bad(body, "clock reserved bytes not 0") end
   if len ~= S_HEAD + n * S_RECORD then bad(body, string.format("payload_len not 80 + 24 x record_count (%d)", len)) end
   local last, off = -1, HEADER + S_HEAD
@@ -396,11 +405,13 @@ local function dissect_summary(ctx, tvb, len, avail)
     rec:add(f.r_rate_mhz, tvb(off + 4, 4))
     rec:add(f.r_lost, tvb(off + 8, 8))
     local age_item = rec:add(f.r_age_ms, tvb(off + 16, 4))
-    if tvb(off + 16, 4):uint() == 0xFFFFFFFF then age_item:append_text(" (none)") end
+    if tvb(off + 16, 4):uint() == NO_AGE then age_item:append_text(" (none)") end
     local res_item = rec:add(f.r_reserved, tvb(off + 20, 4))
     if sig <= last then bad(rec, string.format("record %d: signals not strictly increasing (%d after %d)", i, sig, last)) end
     if role ~= 1 and role ~= 2 then bad(role_item, string.format("record %d: unknown role (%d)", i, role)) end
-    if band(rflags, 0xFC) ~= 0 then bad(flags_item, string.format("record %d: unknown record flag bits (0x%02x)", i, rflags)) end
+    if band(rflags, 0xFF - R_KNOWN) ~= 0 then
+      bad(flags_item, string.format("record %d: unknown record flag bits (0x%02x)", i, rflags))
+    end
     if tvb(off + 20, 4):uint() ~= 0 then bad(res_item, string.format("record %d: reserved not 0", i)) end
     last, off = sig, off + S_RECORD
   end
@@ -502,7 +513,7 @@ local function dissect(tvb, pinfo, tree)
 
   -- 3. the header's own rules
   if band(flags, 0xFF - F_KNOWN) ~= 0 then
-    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", band(flags, 0xF8)))
+    problem(ctx, flags_item, "bad_header", string.format("unknown flag bits 0x%02x", band(flags, 0xFF - F_KNOWN)))
   end
   if reserved ~= 0 then problem(ctx, res_item, "bad_header", string.format("reserved not 0 (0x%04x)", reserved)) end
   if is_summary then

@@ -17,7 +17,7 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
-#include "tools/app_os.h"
+#include "common/platform_app.h"
 
 namespace {
 
@@ -184,8 +184,7 @@ int CmdEcho(ccomm_client* c, int argc, char** argv) {
     }
     if (timeout >= 0 && (static_cast<uint64_t>(ccomm_now()) - start) / 1e9 > timeout) break;
     if (interval_ms > 0) {
-      struct timespec ts = {interval_ms / 1000, (interval_ms % 1000) * 1000000};
-      nanosleep(&ts, nullptr);
+      ccomm::platform::SleepNsInterruptible(static_cast<uint64_t>(interval_ms) * 1000000u);
     } else {
       ccomm_wait(c, 100);
     }
@@ -253,7 +252,7 @@ int CmdPub(ccomm_client* c, int argc, char** argv) {
     }
     if (period_ns && i + 1 < count) {
       next += period_ns;
-      ccomm::app::SleepUntilNs(next);
+      ccomm::platform::SleepUntilNs(next);
       // Woken a period late or more (a stalled machine): go on from now, never in a burst
       // that would exceed HZ (readers and rate figures see what --rate promised).
       const int64_t now = ccomm_now();

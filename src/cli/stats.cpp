@@ -13,6 +13,7 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
+#include "common/platform_app.h"
 
 namespace {
 
@@ -208,13 +209,12 @@ int CmdStats(ccomm_client* c, const char*, int argc, char** argv) {
   Snapshot before = Take(c);
   if (watch <= 0) {
     // One-shot: measure rates over a short window so RX/S means something.
-    usleep(200000);
+    ccomm::platform::SleepNsInterruptible(200000000u);
     Print(c, &before, Take(c), json);
     return 0;
   }
   for (;;) {
-    struct timespec ts = {static_cast<time_t>(watch), static_cast<long>((watch - static_cast<double>(static_cast<time_t>(watch))) * 1e9)};
-    if (nanosleep(&ts, nullptr) != 0) break;
+    if (ccomm::platform::SleepNsInterruptible(ccomm::cli::WatchPeriodNs(watch)) != 0) break;
     if (Retired(c)) {
       fprintf(stderr, "ccomm stats: %s\n", ccomm_strerror(CCOMM_E_RETIRED));
       return 1;

@@ -9,6 +9,8 @@
 #include <string>
 
 #include "ccomm/ccomm.h"
+#include "cli/values.h"
+#include "common/platform_app.h"
 #include "tools/json_text.h"
 
 namespace {
@@ -138,9 +140,7 @@ int CmdStatsAll(ccomm_client* c, bool json, double watch) {
     if (json) PrintJson(c, v);
     else PrintTable(c, v);
     if (watch <= 0) break;
-    struct timespec ts = {static_cast<time_t>(watch),
-                          static_cast<long>((watch - static_cast<double>(static_cast<time_t>(watch))) * 1e9)};
-    if (nanosleep(&ts, nullptr) != 0) break;
+    if (ccomm::platform::SleepNsInterruptible(ccomm::cli::WatchPeriodNs(watch)) != 0) break;
   }
   ccomm_view_close(v);
   return 0;

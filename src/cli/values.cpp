@@ -120,5 +120,10 @@ bool ParseOptionNumber(const char* word, bool integer, bool allow_zero, double* 
   return true;
 }
 
+uint64_t WatchPeriodNs(double seconds) {
+  const uint64_t whole = static_cast<uint64_t>(seconds);
+  return whole * 1000000000u + static_cast<uint64_t>((seconds - static_cast<double>(whole)) * 1e9);
+}
+
 }  // namespace cli
 }  // namespace ccomm

@@ -2,6 +2,7 @@
 // Text <-> value conversion for the CLI (host byte order, as in shared memory).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "ccomm/ccomm.h"
@@ -21,6 +22,8 @@ bool LooksLikeNumber(const char* word);
 /// An option's number: the whole word a finite decimal > 0 (>= 0 with allow_zero), and
 /// integral when `integer`; false for "abc", "1x", "-1", "1.5" (integer), "inf".
 bool ParseOptionNumber(const char* word, bool integer, bool allow_zero, double* out);
+/// A --watch period of `seconds` (> 0) in ns: the whole seconds and the fraction's ns.
+uint64_t WatchPeriodNs(double seconds);
 
 }  // namespace cli
 }  // namespace ccomm

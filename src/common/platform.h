@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // The platform layer (zenoh-pico style): every OS call of the store, the client library
 // and ccommd's threads (clock, futex, shared memory, scheduling, sleeping, logging) goes
-// through this header. It has one unit per platform, whole files chosen by CMake
-// (src/common/CMakeLists.txt), never #ifdefs inside functions:
-//   platform/posix/platform.cpp    Linux (glibc; Xenomai's POSIX skin wraps it)
-//   platform/windows/platform.cpp  Windows x64 (named file mappings, named events)
-// A port (another RTOS) of what runs inside the applications adds one unit. The daemon's
+// through this header and common/platform_app.h, its part the programs of the public API
+// use too (real-time set-up, sleeping, the exclusive lock, segment names). It has one set
+// of units per platform, whole files chosen by CMake (src/common/CMakeLists.txt), never
+// #ifdefs inside functions:
+//   platform/posix/     Linux (glibc; Xenomai's POSIX skin wraps it)
+//   platform/windows/   Windows x64 (named file mappings, named events)
+// A port (another RTOS) of what runs inside the applications adds one folder. The daemon's
 // own OS code (sockets, interfaces, privileges, the key file, ptp4l, stop requests) has
 // one whole file per platform in src/daemon (daemon/sources.cmake, docs/design.md), and
 // config.cpp reads signals.xml through ReadRegularFile. Functions marked [rt] are safe on
@@ -16,6 +18,8 @@
 #include <cstdint>
 #include <atomic>
 #include <string>
+
+#include "common/platform_app.h"
 #if defined(_MSC_VER)
 #include <intrin.h>  // _mm_pause
 #endif
@@ -33,8 +37,7 @@
 namespace ccomm {
 namespace platform {
 
-/// [rt] CLOCK_MONOTONIC in ns (vDSO, no syscall on Linux).
-uint64_t MonotonicNs();
+// MonotonicNs, the sleeps, SetUpRealtime, LockExclusive and SegmentName: platform_app.h.
 /// CLOCK_REALTIME in ns since 1970 (the clock ptp4l disciplines with software
 /// timestamping): the common time base between boards when their clocks are synced.
 uint64_t RealtimeNs();
@@ -91,25 +94,9 @@ void CloseFd(int fd);
 uint64_t ShmRoom();
 uint64_t CgroupMemoryRoom();
 uint64_t AddressSpaceRoom();
-/// An exclusive lock on the object `name` (an shm name) that this process holds until it
-/// exits or dies, also while it is stopped (a SIGSTOPped ccommd keeps its node). Returns a
-/// handle to keep (>= 0), -EBUSY (the holder's pid in *holder_pid when known, else 0), or
-/// -errno. `gid` >= 0 gives the object to that group.
-int LockExclusive(const char* name, int gid, int* holder_pid);
-/// Gives up a lock LockExclusive returned.
-void UnlockExclusive(int handle);
-
-/// Locks current and future memory; returns 0 or -errno.
-int LockAllMemory();
-/// SCHED_FIFO with `priority` (1..99) for the calling thread; 0 or -errno.
-int SetFifoPriority(int priority);
-/// Pins the calling thread to `cpu`; 0 or -errno.
-int PinToCpu(int cpu);
 /// Packets the kernel dropped at socket `fd` since it was opened (receive buffer full;
 /// SO_MEMINFO, the `d` that `ss -m` shows). Returns 0 or -errno. Not [rt]: supervision.
 int SocketDrops(int fd, uint32_t* drops);
-/// Sleeps `ns` nanoseconds (not [rt]: a syscall; for idle and back-off waits).
-void SleepNs(uint64_t ns);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
 
@@ -127,9 +114,6 @@ bool HostName(char* buf, size_t cap);
 /// Dotted-quad IPv4 text to an address in network byte order (inet_pton); false if
 /// `text` is not one. Start-up only (the Windows unit starts Winsock on first use).
 bool ParseIpv4(const char* text, uint32_t* network_order);
-/// The id of group `name` (getgrnam), or -1 if there is none (always on Windows, where a
-/// segment's access follows the mapping's namespace, docs/install.md). Start-up only.
-int NamedGroupId(const char* name);
 
 /// Whether stderr is the journal's stream (systemd sets JOURNAL_STREAM to its
 /// "device:inode"; a child whose stderr was redirected inherits the variable but not the

@@ -95,11 +95,14 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
 void Daemon::EnterIoThread(const char* name) {
   const RealtimeConfig& rt = cfg_->nodes[self_].realtime;
   if (!opt_.no_realtime) {
-    if (rt.priority > 0 && platform::SetFifoPriority(rt.priority) != 0)
+    platform::RealtimeRequest want;
+    want.cpu = rt.cpu;
+    want.fifo_priority = rt.priority;
+    const platform::RealtimeResult got = platform::SetUpRealtime(want);
+    if (got.fifo_priority != 0)
       Log(LogLevel::kWarning, "%s thread: SCHED_FIFO %d refused (needs CAP_SYS_NICE or RLIMIT_RTPRIO); running "
           "SCHED_OTHER", name, rt.priority);
-    if (rt.cpu >= 0 && platform::PinToCpu(rt.cpu) != 0)
-      Log(LogLevel::kWarning, "%s thread: cannot pin to CPU %d", name, rt.cpu);
+    if (got.cpu != 0) Log(LogLevel::kWarning, "%s thread: cannot pin to CPU %d", name, rt.cpu);
   }
   platform::PrefaultStack(32 * 1024);
 }

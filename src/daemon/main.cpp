@@ -494,7 +494,9 @@ int RunDaemon(int argc, char** argv) {
 
   const NodeConfig& self = cfg.nodes[static_cast<size_t>(node)];
   if (!opt.no_realtime && self.realtime.mlockall) {
-    int r = platform::LockAllMemory();
+    platform::RealtimeRequest want;
+    want.lock_memory = true;
+    const int r = platform::SetUpRealtime(want).lock_memory;
     if (r != 0)
       Log(LogLevel::kWarning, "mlockall failed (%s): page faults may add latency; needs CAP_IPC_LOCK or "
           "LimitMEMLOCK=infinity", strerror(-r));

@@ -4,9 +4,7 @@
 #include <fcntl.h>
 #include <ftw.h>
 #include <signal.h>
-#include <sched.h>
 #include <spawn.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -19,6 +17,8 @@
 #include <cstring>
 #include <map>
 #include <new>
+
+#include "common/platform_app.h"
 
 extern char** environ;
 
@@ -241,23 +241,23 @@ void Runner::PrintBindings(FILE* out) const {
 }
 
 void Runner::SetUpRealtime() {
-  if (opt_.cpu >= 0) {  // also with --no-rt: --cpu is an option of its own
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(opt_.cpu, &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0)
-      std::fprintf(stderr, "ccomm-fmu: warning: cannot pin to CPU %d (%s)\n", opt_.cpu, std::strerror(errno));
+  ccomm::platform::RealtimeRequest want;
+  want.cpu = opt_.cpu;  // also with --no-rt: --cpu is an option of its own
+  if (opt_.realtime) {
+    want.lock_memory = true;
+    want.fifo_priority = opt_.priority;
   }
+  const ccomm::platform::RealtimeResult got = ccomm::platform::SetUpRealtime(want);
+  if (got.cpu != 0)
+    std::fprintf(stderr, "ccomm-fmu: warning: cannot pin to CPU %d (%s)\n", opt_.cpu, std::strerror(-got.cpu));
   if (!opt_.realtime) return;
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+  if (got.lock_memory != 0)
     std::fprintf(stderr, "ccomm-fmu: warning: mlockall failed (%s): page faults may delay cycles\n",
-                 std::strerror(errno));
-  sched_param sp{};
-  sp.sched_priority = opt_.priority;
-  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+                 std::strerror(-got.lock_memory));
+  if (got.fifo_priority != 0)
     std::fprintf(stderr, "ccomm-fmu: warning: SCHED_FIFO %d not permitted (%s): running SCHED_OTHER, "
                  "without real-time guarantees (give CAP_SYS_NICE or an rtprio limit)\n",
-                 opt_.priority, std::strerror(errno));
+                 opt_.priority, std::strerror(-got.fifo_priority));
   // Touch the stack the FMU may use so that its pages are resident before the first cycle.
   volatile char stack[256 * 1024];
   for (size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
@@ -415,8 +415,7 @@ int Runner::Run(volatile sig_atomic_t* stop) {
     }
     cycle_ = cycle_ + 1;
     release += period;
-    timespec ts{static_cast<time_t>(release / 1000000000LL), static_cast<long>(release % 1000000000LL)};
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !*stop) {
+    while (ccomm::platform::SleepUntilNs(release) == -EINTR && !*stop) {
     }
   }
   binary_.Finish(kFmi3OK);

@@ -10,15 +10,13 @@
 #include <cstring>
 
 #include "bridge.h"
+#include "common/platform_app.h"
 #include "sample_layout.h"
 
 namespace ccomm_ros2 {
 namespace {
 
-void SleepMs(int ms) {
-  timespec ts{0, ms * 1000000L};
-  nanosleep(&ts, nullptr);
-}
+void SleepMs(int ms) { ccomm::platform::SleepNsInterruptible(static_cast<uint64_t>(ms) * 1000000u); }
 
 enum class Verdict { kOk, kBadLength, kBadValue };
 

@@ -2,11 +2,8 @@
 // ccomm-ros2: start-up (routes from the node's signals and the options), the two
 // worker threads, signals and counters. See docs/integrations/ros2.md.
 #include <ctime>
-#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
-#include <sys/file.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -17,6 +14,7 @@
 
 #include "bridge.h"
 #include "section.h"
+#include "common/platform_app.h"
 
 namespace ccomm_ros2 {
 
@@ -34,43 +32,32 @@ ccomm_client* OpenWaiting(Bridge* b) {
               b->node.empty() ? "(default)" : b->node.c_str(), ccomm_strerror(rc));
       told = true;
     }
-    timespec ts{0, 200 * 1000000L};
-    nanosleep(&ts, nullptr);
+    ccomm::platform::SleepNsInterruptible(200 * 1000000u);
   }
   return nullptr;
 }
 
 bool ClaimNodeAndDomain(const Bridge* b) {
-  // Beside the node's segment ($CCOMM_SHM_PREFIX, default "/ccomm."), so a test's own
-  // prefix gets its own lock. flock: released by the kernel however the holder ends,
-  // and still held by a stopped (SIGSTOP) bridge, which would resume publishing.
-  const char* prefix = getenv("CCOMM_SHM_PREFIX");
-  const std::string name = std::string(prefix && *prefix ? prefix : "/ccomm.") + b->node + ".ros2-domain" +
-                           std::to_string(b->opt.domain);
-  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  // Left by a bridge of another user (root, then the unit's user): a read-only
-  // descriptor locks the same (only the pid in it is not ours then).
-  if (fd < 0 && errno == EACCES) fd = shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
-  if (fd < 0) {
-    fprintf(stderr, "ccomm-ros2: cannot create the lock %s in /dev/shm: %s\n", name.c_str(), strerror(errno));
-    return false;
-  }
-  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    char holder[32] = "";
-    const ssize_t n = pread(fd, holder, sizeof holder - 1, 0);
-    holder[n > 0 ? n : 0] = '\0';
+  // Beside the node's segment (its name with $CCOMM_SHM_PREFIX), so a test's own prefix
+  // gets its own lock. The platform layer's exclusive lock: released by the kernel however
+  // the holder ends, still held by a stopped (SIGSTOP) bridge, which would resume
+  // publishing, and it names its holder. Group "ccomm" if it exists (as ccommd's node
+  // lock): a bridge run by hand as root and then by the unit's user share the object.
+  const std::string name = ccomm::platform::SegmentName(b->node) + ".ros2-domain" + std::to_string(b->opt.domain);
+  int holder = 0;
+  const int lock = ccomm::platform::LockExclusive(name.c_str(), ccomm::platform::NamedGroupId("ccomm"), &holder);
+  if (lock == -EBUSY) {
     fprintf(stderr, "ccomm-ros2: another ccomm-ros2 (pid %s) already bridges node %s on DDS domain %d: "
                     "not starting a second one (every value would reach ROS 2 twice); stop it first "
-                    "(lock /dev/shm%s)\n", holder[0] ? holder : "?", b->node.c_str(), b->opt.domain, name.c_str());
-    close(fd);
+                    "(lock /dev/shm%s)\n", holder > 0 ? std::to_string(holder).c_str() : "?", b->node.c_str(),
+            b->opt.domain, name.c_str());
     return false;
   }
-  char pid[32];
-  const int len = snprintf(pid, sizeof pid, "%d", static_cast<int>(getpid()));
-  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, static_cast<size_t>(len), 0) != len) {
-    // the pid is only for the message above: the lock itself is held
+  if (lock < 0) {
+    fprintf(stderr, "ccomm-ros2: cannot create the lock %s in /dev/shm: %s\n", name.c_str(), strerror(-lock));
+    return false;
   }
-  return true;  // fd stays open (and locked) until the process ends
+  return true;  // held (never unlocked) until the process ends
 }
 
 bool ResolveRoutes(Bridge* b, ccomm_client* c, const std::vector<Route*>& routes) {

@@ -5,9 +5,6 @@
 // Nothing is allocated per sample here. A state this node receives is read through the
 // history tap when the node has one (<node history="N">): every value is published, not
 // only the newest at each wake-up.
-#include <pthread.h>
-#include <sched.h>
-#include <sys/mman.h>
 
 #include <cstring>
 #include <ctime>
@@ -16,6 +13,7 @@
 #include <cstdio>
 
 #include "bridge.h"
+#include "common/platform_app.h"
 #include "sample_layout.h"
 
 namespace ccomm_ros2 {
@@ -208,13 +206,13 @@ void FollowView(Bridge* b, ccomm_client* c) {
 void RunToRos(Bridge* b) {
   if (b->to_ros.empty()) return;
   if (b->opt.priority > 0) {
-    mlockall(MCL_CURRENT | MCL_FUTURE);  // no page fault delays the real-time reader
-    sched_param sp{};
-    sp.sched_priority = b->opt.priority;
-    int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    ccomm::platform::RealtimeRequest want;
+    want.lock_memory = true;  // no page fault delays the real-time reader (best effort)
+    want.fifo_priority = b->opt.priority;
+    const int rc = ccomm::platform::SetUpRealtime(want).fifo_priority;
     if (rc != 0)
       fprintf(stderr, "ccomm-ros2: --priority %d: %s (needs CAP_SYS_NICE); running without\n",
-              b->opt.priority, strerror(rc));
+              b->opt.priority, strerror(-rc));
   }
   ccomm_client* c = OpenWaiting(b);
   if (!c) return;

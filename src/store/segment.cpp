@@ -2,7 +2,6 @@
 #include "store/segment.h"
 
 #include <errno.h>
-#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -13,11 +12,6 @@
 
 namespace ccomm {
 namespace store {
-
-std::string SegmentName(const std::string& node) {
-  const char* prefix = getenv("CCOMM_SHM_PREFIX");
-  return std::string(prefix && *prefix ? prefix : "/ccomm.") + node;
-}
 
 StateView Segment::state(uint32_t id) const {
   const SignalDirectoryEntry& d = dir(id);

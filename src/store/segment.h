@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "common/platform_app.h"
 #include "store/event_ring.h"
 #include "store/layout.h"
 #include "store/state_slot.h"
@@ -15,8 +16,9 @@
 namespace ccomm {
 namespace store {
 
-/// POSIX shm name of a node's segment: $CCOMM_SHM_PREFIX (default "/ccomm.") + node.
-std::string SegmentName(const std::string& node);
+/// POSIX shm name of a node's segment: $CCOMM_SHM_PREFIX (default "/ccomm.") + node,
+/// built by the platform layer (common/platform_app.h) for every user of the name.
+using platform::SegmentName;
 
 class Segment {
  public:

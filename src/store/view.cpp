@@ -5,7 +5,6 @@
 #include <errno.h>
 #include <string.h>
 
-#include <cstdlib>
 
 #include "common/platform.h"
 #include "store/word_copy.h"  // the seqlock fences (and their TSan form)
@@ -22,10 +21,7 @@ constexpr int kReadTries = 64;  // a write is a few dozen stores: this many retr
 
 }  // namespace
 
-std::string View::NameFor(const std::string& node) {
-  const char* prefix = getenv("CCOMM_SHM_PREFIX");
-  return std::string(prefix && *prefix ? prefix : "/ccomm.") + node + ".view";
-}
+std::string View::NameFor(const std::string& node) { return platform::SegmentName(node) + ".view"; }
 
 size_t View::SizeFor(uint32_t nodes, uint32_t signals) {
   return RowsOffset(nodes) + size_t{nodes} * signals * sizeof(ViewRow);

@@ -14,6 +14,8 @@
 #include <string>
 #include <thread>
 
+#include "common/platform.h"
+
 namespace ccomm {
 namespace store {
 namespace {
@@ -58,30 +60,30 @@ TEST(View, CreateWriteReadBack) {
   // O_RDONLY): a client cannot corrupt what other clients read.
   EXPECT_EQ(mprotect(const_cast<ViewHeader*>(r.header()), 4096, PROT_READ | PROT_WRITE), -1);
   EXPECT_EQ(errno, EACCES);
-  ASSERT_EQ(shm_unlink(name.c_str()), 0);
+  ASSERT_EQ(platform::ShmUnlink(name.c_str()), 0);
 }
 
 TEST(View, OpenRefusesWhatIsNoView) {
   View r;
   EXPECT_EQ(r.OpenReadOnly(TestName("missing")), -ENOENT);
   const std::string name = TestName("junk");
-  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
+  int fd = platform::ShmOpen(name.c_str(), /*create_exclusive=*/true, 0600);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(ftruncate(fd, 4096), 0);  // zeros: not initialised, wrong magic
   close(fd);
   EXPECT_EQ(r.OpenReadOnly(name), -EPROTO);
-  fd = shm_open(name.c_str(), O_RDWR, 0);
+  fd = platform::ShmOpen(name.c_str(), false, 0);
   ASSERT_EQ(ftruncate(fd, 8), 0);  // shorter than a header
   close(fd);
   EXPECT_EQ(r.OpenReadOnly(name), -EPROTO);
-  shm_unlink(name.c_str());
+  platform::ShmUnlink(name.c_str());
   // A view whose recorded size disagrees with its dimensions.
   View w;
   std::string err;
   ASSERT_EQ(w.Create(name, 2, 2, 0, 0, -1, &err), 0) << err;
   w.mutable_header()->signal_count = 1000;
   EXPECT_EQ(r.OpenReadOnly(name), -EPROTO);
-  shm_unlink(name.c_str());
+  platform::ShmUnlink(name.c_str());
 }
 
 // One writer rewrites node 1 and a row with the same number in every word; readers must
@@ -129,7 +131,7 @@ TEST(View, SeqlockGivesConsistentCopies) {
   EXPECT_EQ(mixed, 0u);
   EXPECT_GT(copies, 0u);
   EXPECT_GT(last, 0u);
-  shm_unlink(name.c_str());
+  platform::ShmUnlink(name.c_str());
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // ccomm-latency: a control-loop-shaped load and latency probe, app -> ccommd -> wire ->
 // ccommd -> app. Used by scripts/demo, scripts/bench and the QEMU tests.
 //
-// Each cycle (clock_nanosleep, absolute) the sender writes every --send signal with the
+// Each cycle (platform::SleepUntilNs, absolute) the sender writes every --send signal with the
 // cycle number k as value, then ccomm_flush(): one frame per cycle. A receive thread
 // blocks in ccomm_wait() and records, for each cycle whose --recv signals have all
 // arrived, the latency:
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
-#include "tools/app_os.h"
+#include "common/platform_app.h"
 #include "tools/json_text.h"
 
 namespace {
@@ -147,11 +147,11 @@ void* Receiver(void* arg) {
       if (!is_event[i]) break;
     }
   }
-  if (s->prio > 0) ccomm::app::SetFifoPriority(s->prio);  // best effort, reported by main
-  if (s->cpu >= 0) {
-    const int err = ccomm::app::PinToCpu(s->cpu);  // before the loop: a message is fine here
-    if (err != 0) fprintf(stderr, "ccomm-latency: cannot pin the receive thread to CPU %d (%s)\n", s->cpu, strerror(err));
-  }
+  ccomm::platform::RealtimeRequest want;
+  want.cpu = s->cpu;
+  want.fifo_priority = s->prio;  // best effort, reported by main
+  const int err = ccomm::platform::SetUpRealtime(want).cpu;  // before the loop: a message is fine here
+  if (err != 0) fprintf(stderr, "ccomm-latency: cannot pin the receive thread to CPU %d (%s)\n", s->cpu, strerror(-err));
   while (!s->stop.load(std::memory_order_relaxed)) {
     if (!s->spin) ccomm_wait(s->rx_client, 50);
     bool changed = false;
@@ -344,23 +344,25 @@ int main(int argc, char** argv) {
   s.send_time.assign(kHistory, 0);
   s.samples.reserve(static_cast<size_t>(o.rate * o.duration) + 16);
   s.last_hop.reserve(s.samples.capacity());
-  ccomm::app::LockMemory();  // best effort
+  ccomm::platform::RealtimeRequest lock;
+  lock.lock_memory = true;
+  ccomm::platform::SetUpRealtime(lock);  // best effort
 
   uint64_t start = Now();
   s.warmup_until = start + static_cast<uint64_t>(o.warmup * 1e9);
   pthread_t rx;
   pthread_create(&rx, nullptr, Receiver, &s);
-  if (o.prio > 0) {
-    if (ccomm::app::SetFifoPriority(o.prio) != 0)
-      fprintf(stderr, "ccomm-latency: SCHED_FIFO refused; running SCHED_OTHER\n");
-  }
+  ccomm::platform::RealtimeRequest fifo;
+  fifo.fifo_priority = o.prio;
+  if (ccomm::platform::SetUpRealtime(fifo).fifo_priority != 0)
+    fprintf(stderr, "ccomm-latency: SCHED_FIFO refused; running SCHED_OTHER\n");
   const uint64_t period = static_cast<uint64_t>(1e9 / o.rate);
   const uint64_t end = start + static_cast<uint64_t>(o.duration * 1e9);
   uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
   uint64_t overruns = 0;  // cycles skipped because the loop woke a whole period late or more
   for (uint64_t k = 1;; ++k) {
     next += period;
-    ccomm::app::SleepUntilNs(static_cast<int64_t>(next));
+    ccomm::platform::SleepUntilNs(static_cast<int64_t>(next));
     const uint64_t woke = Now();
     if (woke >= end) break;
     // Woken after the next cycle's start (the machine stalled this thread): skip the
@@ -377,8 +379,7 @@ int main(int argc, char** argv) {
     s.sent.fetch_add(1, std::memory_order_relaxed);
   }
   // Let the last frames arrive.
-  struct timespec tail = {0, 200 * 1000 * 1000};
-  nanosleep(&tail, nullptr);
+  ccomm::platform::SleepNsInterruptible(200 * 1000 * 1000);
   s.stop = true;
   pthread_join(rx, nullptr);
 

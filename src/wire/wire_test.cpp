@@ -333,7 +333,7 @@ TEST(WireVersion, EveryCopyFollowsKVersion) {
   const std::string v = std::to_string(unsigned{ccomm::wire::kVersion});
   const std::pair<const char*, std::string> copies[] = {
       {"scripts/wire_vectors.py", "\nVERSION = " + v + "\n"},
-      {"integrations/wireshark/ccomm.lua", "local MAGIC, VERSION = 0x43434D57, " + v + "\n"},
+      {"integrations/wireshark/ccomm.lua", "local MAGIC, VERSION = 0x43434D57, " + v + "  -- wire: kMagic, kVersion\n"},
       {"tests/reliability/authframe.py", "MAGIC, VERSION, FLAG_HEARTBEAT, FLAG_AUTH = 0x43434D57, " + v + ","},
       {"tests/reliability/flood.c", "f[4] = " + v + "; /* wire::kVersion"},
       {"docs/protocol.md", "# ccomm wire protocol, version " + v + "\n"},

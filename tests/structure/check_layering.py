@@ -10,10 +10,15 @@
 - libccomm.so (the client library every application loads) carries no XML parser:
   no RapidXML, no configuration parser, no config library symbol, exports nothing but
   the C API (ccomm_*), and needs no library beyond the C/C++ runtime;
-- the applications of the public API (the CLI, tools, the ROS 2 bridge) include nothing
-  of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp only, and a program
-  that owns an extension section of signals.xml (the bridge's <ros2>) the configuration's
-  public interface config/outline.h, which itself includes standard headers only;
+- the applications of the public API (the CLI, tools, the FMU runner, the ROS 2 bridge)
+  include nothing of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp
+  only, the platform layer's part for programs (common/platform_app.h: real-time set-up,
+  sleeps, the exclusive lock, segment names), and a program that owns an extension
+  section of signals.xml (the bridge's <ros2>) the configuration's public interface
+  config/outline.h; a public interface itself includes standard headers only;
+- OS calls the platform layer wraps (shared memory, memory locking, scheduling, CPU
+  affinity, sleeping) are made only in its units, src/common/platform/: nowhere else
+  under src/, tests included (FORBIDDEN_CALLS);
 - no two source files under src/ share a name (two system_view.cpp once meant two
   different things), except the platform units and each program's main.cpp;
 - signals.xml has one parser (src/config/): no other code uses an XML parser on it
@@ -29,14 +34,29 @@ import sys
 
 BOTTOM = {"store": {"store", "common"}, "wire": {"wire", "common"}}
 UPPER = ("config", "daemon", "client")
-APPLICATIONS = ("cli", "tools", "ros2")
+APPLICATIONS = ("cli", "tools", "fmu", "ros2")
 INTERNALS = {"config", "daemon", "store", "wire", "client", "common"}
 # (file, include): why it is allowed for now (none: keep it that way).
 APPLICATION_INCLUDES = {}
 # Public interfaces of internal modules, and who may include them.
 PUBLIC_INTERFACES = {
     "config/outline.h": "the configuration as the owner of an extension section reads it (src/ros2: <ros2>)",
+    "common/platform_app.h": "the platform layer's part for programs: real-time set-up, sleeps, the exclusive "
+                             "lock, segment names (one implementation for ccommd, the library and the programs)",
 }
+# OS calls only the platform layer's units (src/common/platform/) make: the POSIX calls
+# and their Windows counterparts. Anywhere else under src/ a call of one fails the test
+# (comments and string literals aside); use common/platform.h or common/platform_app.h.
+PLATFORM_DIR = "src/common/platform/"
+FORBIDDEN_CALLS = ("shm_open", "shm_unlink", "mlockall", "munlockall", "sched_setscheduler", "sched_setaffinity",
+                   "pthread_setschedparam", "pthread_setaffinity_np", "nanosleep", "clock_nanosleep", "flock",
+                   "SetThreadPriority", "SetThreadAffinityMask", "SetProcessWorkingSetSize", "CreateFileMapping", "CreateFileMappingA",
+                   "CreateFileMappingW", "OpenFileMapping", "OpenFileMappingA", "OpenFileMappingW")
+FORBIDDEN_CALL = re.compile(r"(?<![\w.>:])(?:::)?(%s)\s*\(" % "|".join(FORBIDDEN_CALLS))
+C_CODE = (".c", ".cc", ".cpp", ".h", ".hpp")
+# Comments, string and character literals (raw strings first): what is not code.
+NOT_CODE = re.compile(r'R"([^(\s]*)\((?:.|\n)*?\)\1"|//[^\n]*|/\*(?:.|\n)*?\*/|"(?:\\.|[^"\\\n])*"|'
+                      r"'(?:\\.|[^'\\\n])*'")
 CODE = (".py", ".lua", ".c", ".cc", ".cpp", ".h", ".hpp", ".js", ".ts")
 XML_PARSERS = re.compile(r"ElementTree|xml\.dom|\blxml\b|rapidxml|\bexpat\b|xml_attr\(")
 TYPE_NAMES = ("bool", "int32", "uint32", "int64", "float", "double")
@@ -136,6 +156,19 @@ def unique_file_names(src, errors):
                           % (base, len(names), ", ".join(names)))
 
 
+def os_calls_in_platform_layer(src, errors):
+    """The calls of FORBIDDEN_CALLS only in src/common/platform/."""
+    for name in tracked_code(src):
+        if not name.startswith("src/") or name.startswith(PLATFORM_DIR) or not name.endswith(C_CODE):
+            continue
+        text = open(os.path.join(src, name), encoding="utf-8", errors="replace").read()
+        code = NOT_CODE.sub(lambda m: "\n" * m.group(0).count("\n"), text)  # keeps line numbers
+        for m in FORBIDDEN_CALL.finditer(code):
+            errors.append("%s:%d calls %s(): an OS call the platform layer wraps (common/platform.h, "
+                          "common/platform_app.h; its units are in %s)"
+                          % (name, code.count("\n", 0, m.start()) + 1, m.group(1), PLATFORM_DIR))
+
+
 def public_interfaces(src, errors):
     """A public interface is public only if it pulls in no internals."""
     for header in PUBLIC_INTERFACES:
@@ -150,6 +183,7 @@ def main():
     errors = []
     application_includes(src, errors)
     public_interfaces(src, errors)
+    os_calls_in_platform_layer(src, errors)
     unique_file_names(src, errors)
     one_parser_one_table(src, errors)
     # 1. Includes of the bottom modules.
@@ -204,7 +238,8 @@ def main():
         print("layering: " + e)
     if not errors:
         print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
-              "applications use the public API (and config/outline.h); one file per name; one parser of signals.xml, one table of type names")
+              "applications use the public API (and config/outline.h, common/platform_app.h); OS calls of the "
+              "platform layer only in its units; one file per name; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 
 

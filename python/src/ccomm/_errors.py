@@ -60,10 +60,11 @@ class DaemonNotRunningError(CcommError, ConnectionError):
     restarted ccommd makes a new segment; this client then gets RetiredError."""
 
 
-# The codes the record and replay loops compare results with (they raise no exception).
-E_FULL, E_BUSY, E_CORRUPT = -5, -6, -10
+# The codes the record and replay loops and the system view compare results with (they
+# raise no exception).
+E_NOENT, E_FULL, E_BUSY, E_CORRUPT = -2, -5, -6, -10
 
-_ERRORS = {-1: InvalidArgumentError, -2: NotFoundError, -3: TypeMismatchError,
+_ERRORS = {-1: InvalidArgumentError, E_NOENT: NotFoundError, -3: TypeMismatchError,
            -4: NotProducerError, E_FULL: QueueFullError, E_BUSY: BusyError, -7: SystemCallError,
            -8: VersionError, -9: RetiredError, E_CORRUPT: CorruptError}
 

@@ -7,9 +7,10 @@ import ctypes
 from typing import Any, Dict, List, Optional
 
 from . import _native
-from ._errors import _check
+from ._errors import E_NOENT, _check
 
-_ROLES = {1: "producer", 2: "consumer"}
+ROLE_PRODUCER, ROLE_CONSUMER = 1, 2  # ccomm_view_signal.role
+_ROLES = {ROLE_PRODUCER: "producer", ROLE_CONSUMER: "consumer"}
 
 
 def system_view(handle: int) -> Dict[str, Any]:
@@ -30,7 +31,7 @@ def system_view(handle: int) -> Dict[str, Any]:
             for s in range(n_signals):
                 vs = _native.ViewSignal()
                 rc = L.ccomm_view_get_signal_sized(v, n, s, ctypes.byref(vs), ctypes.sizeof(vs))
-                if rc == -2:  # CCOMM_E_NOENT
+                if rc == E_NOENT:
                     continue  # the node neither produces nor consumes it (or no report yet)
                 _check(rc, "system view")
                 signals.append({"name": vs.name.decode(), "role": _ROLES.get(vs.role, str(vs.role)),

@@ -43,7 +43,7 @@ from ._types import Status as Status
 from ._types import Value as Value
 from ._types import ValueLike as ValueLike
 
-_SAFE_VALUE = 0x1  # CCOMM_INFO_SAFE_VALUE
+_INFO_SAFE_VALUE = 0x1  # CCOMM_INFO_SAFE_VALUE
 
 
 class Signal:
@@ -78,7 +78,7 @@ class Signal:
         r = _native.lib().ccomm_read(self._client._handle(), self.info.id, self._buf,
                                      self.info.value_bytes, ctypes.byref(self._cinfo))
         status = Status(_check(r, f"read {self.info.name}"))
-        if status == Status.NEVER and not self._cinfo.flags & _SAFE_VALUE:
+        if status == Status.NEVER and not self._cinfo.flags & _INFO_SAFE_VALUE:
             ctypes.memset(self._buf, 0, self.info.value_bytes)
         return status
 
@@ -87,7 +87,7 @@ class Signal:
         if status == Status.EMPTY:
             return Reading(None, status, 0, None, 0, int(ci.lost), False)
         return Reading(value, status, int(ci.seq), None if ci.age_ns < 0 else int(ci.age_ns),
-                       int(ci.source_time_ns), int(ci.lost), bool(ci.flags & _SAFE_VALUE))
+                       int(ci.source_time_ns), int(ci.lost), bool(ci.flags & _INFO_SAFE_VALUE))
 
     def read(self) -> Reading:
         """State signal: the current value. Event signal: the next event, or EMPTY.

@@ -22,11 +22,12 @@ import numpy.typing as npt
 
 from . import _native
 from ._errors import _check
+from ._types import Status
 
 if TYPE_CHECKING:
     from .client import Signal, Value
 
-_EMPTY = 3  # CCOMM_EMPTY
+_EMPTY = int(Status.EMPTY)  # a plain int: compared with every call's result
 
 
 @dataclass(frozen=True)

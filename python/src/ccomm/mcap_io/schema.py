@@ -42,7 +42,7 @@ import json
 import struct
 from typing import Any, Callable, Dict, Tuple
 
-from ..client import STATUS_NAMES, TYPE_FORMATS, SignalInfo
+from ..client import STATUS_NAMES, TYPE_FORMATS, SignalInfo, Status
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -61,8 +61,10 @@ FLAG_INITIAL = 0x2
 # A record with this signal id (and no value bytes) is a watermark: the capture has read
 # every value that arrived up to its receive time, so the writer can write those in order.
 WATERMARK_ID = 0xFFFF
+_FRESH = int(Status.FRESH)  # a plain int: compared for every message
 # ccomm_production_age_code by value (ccomm_production_age_name; read once from libccomm
-# by the recorder, fixed here so the writer and the schema need no library).
+# by the recorder, fixed here so the writer and the schema need no library; held to
+# ccomm.h by tests/structure/check_constants.py).
 AGE_CODES = ("synced", "same_node", "never", "local_unsynced", "producer_unsynced", "no_summary")
 
 
@@ -157,8 +159,8 @@ def message_encoder(desc: SignalInfo) -> Tuple[struct.Struct, MessageEncoder]:
         else:
             text = "[" + ",".join(map(number, vals)) + "]"
         return (head + text + "," + tail % (
-            seq, src, recv, STATUS_NAMES[status] if status < 4 else "?",
-            "true" if status == 0 else "false", "true" if flags & FLAG_SAFE_VALUE else "false",
+            seq, src, recv, STATUS_NAMES[status] if status < len(STATUS_NAMES) else "?",
+            "true" if status == _FRESH else "false", "true" if flags & FLAG_SAFE_VALUE else "false",
             lost, gap, "true" if flags & FLAG_INITIAL else "false",
             prod if prod >= 0 else "null", prod_err if prod >= 0 else "null",
             AGE_CODES[code] if 0 <= code < len(AGE_CODES) else "?")).encode()

@@ -1,12 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// POSIX unit, start-up only: room for a new segment and the node lock (platform.h).
+// POSIX unit, start-up only: room for a new segment (platform.h).
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/resource.h>
-#include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
@@ -60,40 +57,6 @@ uint64_t AddressSpaceRoom() {
   }
   const uint64_t used = pages * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
   return rl.rlim_cur > used ? rl.rlim_cur - used : 0;
-}
-
-// A record lock (fcntl) on a small shm object: the kernel drops it when the process
-// exits or is killed, and a stopped process keeps it.
-int LockExclusive(const char* name, int gid, int* holder_pid) {
-  *holder_pid = 0;
-  int fd = shm_open(name, O_RDWR | O_CREAT | O_CLOEXEC, 0660);
-  if (fd < 0) return -errno;
-  // The first holder creates it: umask must not narrow it, and the group shares it.
-  struct stat st;
-  if (fstat(fd, &st) == 0 && st.st_uid == geteuid()) {
-    if (fchmod(fd, 0660) != 0) { /* best effort: the lock works without */ }
-    if (gid >= 0 && fchown(fd, static_cast<uid_t>(-1), static_cast<gid_t>(gid)) != 0) { /* idem */ }
-  }
-  struct flock lk;
-  memset(&lk, 0, sizeof lk);
-  lk.l_type = F_WRLCK;
-  lk.l_whence = SEEK_SET;
-  if (fcntl(fd, F_SETLK, &lk) == 0) return fd;
-  const int e = errno;
-  if (e == EAGAIN || e == EACCES) {
-    memset(&lk, 0, sizeof lk);
-    lk.l_type = F_WRLCK;
-    lk.l_whence = SEEK_SET;
-    if (fcntl(fd, F_GETLK, &lk) == 0 && lk.l_type != F_UNLCK) *holder_pid = lk.l_pid;
-    close(fd);
-    return -EBUSY;
-  }
-  close(fd);
-  return -e;
-}
-
-void UnlockExclusive(int handle) {
-  if (handle >= 0) close(handle);
 }
 
 }  // namespace platform

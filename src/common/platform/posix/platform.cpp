@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// The platform layer's POSIX unit (Linux, glibc; see common/platform.h).
+// The platform layer's POSIX unit (Linux, glibc; see common/platform.h); the clock, sleeps
+// and real-time set-up are in realtime.cpp, the exclusive lock in exclusive_lock.cpp.
 #include "common/platform.h"
 
 #include <dirent.h>
@@ -7,11 +8,9 @@
 #include <fcntl.h>
 #include <arpa/inet.h>
 #include <fnmatch.h>
-#include <grp.h>
 #include <linux/futex.h>
 #include <linux/sock_diag.h>
 #include <pthread.h>
-#include <sched.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,12 +26,6 @@ namespace ccomm {
 namespace platform {
 
 static_assert(sizeof(std::atomic<uint32_t>) == sizeof(uint32_t), "futex word must be a plain u32");
-
-uint64_t MonotonicNs() {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
 
 uint64_t RealtimeNs() {
   struct timespec ts;
@@ -137,22 +130,6 @@ void CloseFd(int fd) {
   if (fd >= 0) close(fd);
 }
 
-int LockAllMemory() { return mlockall(MCL_CURRENT | MCL_FUTURE) == 0 ? 0 : -errno; }
-
-int SetFifoPriority(int priority) {
-  struct sched_param sp;
-  memset(&sp, 0, sizeof sp);
-  sp.sched_priority = priority;
-  return -pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-}
-
-int PinToCpu(int cpu) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
-  return -pthread_setaffinity_np(pthread_self(), sizeof set, &set);
-}
-
 int SocketDrops(int fd, uint32_t* drops) {
   uint32_t mem[SK_MEMINFO_VARS] = {};
   socklen_t len = sizeof mem;
@@ -203,23 +180,12 @@ bool ParseIpv4(const char* text, uint32_t* network_order) {
   return true;
 }
 
-int NamedGroupId(const char* name) {
-  const struct group* g = getgrnam(name);
-  return g ? static_cast<int>(g->gr_gid) : -1;
-}
-
 bool HostName(char* buf, size_t cap) {
   if (gethostname(buf, cap) != 0) return false;
   buf[cap - 1] = '\0';
   char* dot = strchr(buf, '.');  // node names are short host names
   if (dot) *dot = '\0';
   return buf[0] != '\0';
-}
-
-void SleepNs(uint64_t ns) {
-  struct timespec ts = {static_cast<time_t>(ns / 1000000000ull), static_cast<long>(ns % 1000000000ull)};
-  while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
-  }
 }
 
 int ListShm(const char* prefix, char* first, size_t cap) {

@@ -13,7 +13,8 @@
 //   FutexWake sets it, FutexWait waits on it and re-checks the word. A waiter that wakes
 //   to a changed word sets the event again, so every waiter of a wake-all wakes in turn.
 //   A word outside shared memory gets an unnamed event the same way.
-// - No mlockall, SCHED_FIFO or per-socket drop counter: the nearest calls, or -ENOSYS.
+// - No per-socket drop counter: -ENOSYS. The clock, sleeps and real-time set-up are in
+//   realtime.cpp, the exclusive lock in exclusive_lock.cpp.
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +27,7 @@
 // clang-format on
 
 #include "common/platform.h"
+#include "common/platform/windows/errno_of.h"
 
 namespace ccomm {
 namespace platform {
@@ -67,21 +69,6 @@ struct Locked {
   Locked() { AcquireSRWLockExclusive(&g_lock); }
   ~Locked() { ReleaseSRWLockExclusive(&g_lock); }
 };
-
-int ErrnoOf(DWORD e) {
-  switch (e) {
-    case ERROR_FILE_NOT_FOUND:
-    case ERROR_PATH_NOT_FOUND: return ENOENT;
-    case ERROR_ALREADY_EXISTS: return EEXIST;
-    case ERROR_ACCESS_DENIED:
-    case ERROR_PRIVILEGE_NOT_HELD: return EACCES;
-    case ERROR_NOT_ENOUGH_MEMORY:
-    case ERROR_OUTOFMEMORY:
-    case ERROR_COMMITMENT_LIMIT: return ENOMEM;
-    case ERROR_INVALID_HANDLE: return EBADF;
-    default: return EIO;
-  }
-}
 
 bool WindowsName(const char* posix_name, char* out, size_t cap) {
   const char* ns = getenv("CCOMM_SHM_NAMESPACE");
@@ -170,18 +157,6 @@ HANDLE EventOf(std::atomic<uint32_t>* word) {
 }
 
 }  // namespace
-
-uint64_t MonotonicNs() {
-  static const int64_t freq = [] {
-    LARGE_INTEGER f;
-    QueryPerformanceFrequency(&f);
-    return f.QuadPart;
-  }();
-  LARGE_INTEGER c;
-  QueryPerformanceCounter(&c);  // no kernel call on Windows 10 (TSC page)
-  const uint64_t ticks = static_cast<uint64_t>(c.QuadPart), f = static_cast<uint64_t>(freq);
-  return ticks / f * 1000000000ull + ticks % f * 1000000000ull / f;
-}
 
 uint64_t RealtimeNs() {
   FILETIME ft;
@@ -366,41 +341,7 @@ void CloseFd(int fd) {
   o->in_use = false;
 }
 
-// Windows pages a process's memory in and out as it likes; a larger working set is the
-// nearest thing to mlockall and needs no privilege.
-int LockAllMemory() {
-  return SetProcessWorkingSetSize(GetCurrentProcess(), 64u << 20, 256u << 20) ? 0 : -ErrnoOf(GetLastError());
-}
-
-// The highest priority of a normal process's class; the real-time class needs the
-// process to ask for it (and administrator rights).
-int SetFifoPriority(int /*priority*/) {
-  return SetThreadPriority(GetCurrentThread(), THREAD_PRIORITY_TIME_CRITICAL) ? 0 : -EPERM;
-}
-
-int PinToCpu(int cpu) {
-  if (cpu < 0 || cpu >= 64) return -EINVAL;
-  return SetThreadAffinityMask(GetCurrentThread(), DWORD_PTR{1} << cpu) ? 0 : -EINVAL;
-}
-
 int SocketDrops(int /*fd*/, uint32_t* /*drops*/) { return -ENOSYS; }  // Winsock counts none per socket
-
-void SleepNs(uint64_t ns) {
-  // A waitable timer sleeps below Sleep()'s millisecond tick where Windows offers the
-  // high-resolution kind (10 1803+); one per thread, made on first use.
-  static thread_local HANDLE timer = [] {
-    HANDLE t = CreateWaitableTimerExW(nullptr, nullptr, 0x00000002 /*CREATE_WAITABLE_TIMER_HIGH_RESOLUTION*/,
-                                      TIMER_ALL_ACCESS);
-    return t ? t : CreateWaitableTimerExW(nullptr, nullptr, 0, TIMER_ALL_ACCESS);
-  }();
-  LARGE_INTEGER due;
-  due.QuadPart = -static_cast<LONGLONG>((ns + 99) / 100);  // relative, 100 ns units
-  if (timer && SetWaitableTimer(timer, &due, 0, nullptr, nullptr, FALSE)) {
-    WaitForSingleObject(timer, INFINITE);
-    return;
-  }
-  Sleep(static_cast<DWORD>((ns + 999999) / 1000000));
-}
 
 // Named objects cannot be listed without the native API: ccomm_open() by hostname finds
 // the node only when the node is named after the host (or CCOMM_NODE names it).
@@ -495,8 +436,6 @@ bool ParseIpv4(const char* text, uint32_t* network_order) {
   *network_order = a.s_addr;
   return true;
 }
-
-int NamedGroupId(const char* /*name*/) { return -1; }
 
 bool StderrIsJournal() { return false; }  // no journald: the service logs to a file
 

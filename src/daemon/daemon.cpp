@@ -83,13 +83,18 @@ int Daemon::Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions
   if (r != 0) return r;
   send_.StartCycle();  // send on the cycle (send_cycle_daemon.cpp)
 
-  uint64_t now = platform::MonotonicNs();
+  StartRunning();
+  return 0;
+}
+
+// The periods start now; clients see this ccommd alive; the I/O threads may run.
+void Daemon::StartRunning() {
+  const uint64_t now = platform::MonotonicNs();
   send_.StartPeriods(now);
   store::SegmentHeader* h = segment_.header();
   h->daemon_pid.store(static_cast<int32_t>(platform::ProcessId()), std::memory_order_release);
   h->daemon_heartbeat_ns.store(now, std::memory_order_release);
   handoffs_.running.store(true);
-  return 0;
 }
 
 void Daemon::EnterIoThread(const char* name) {

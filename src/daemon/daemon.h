@@ -91,6 +91,7 @@ class Daemon {
  private:
   /// Real-time set-up of an I/O thread: SCHED_FIFO and CPU from <realtime>, stack prefault.
   void EnterIoThread(const char* name);
+  void StartRunning();
 
   const SystemConfig* cfg_ = nullptr;
   uint32_t self_ = 0;

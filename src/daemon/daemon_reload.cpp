@@ -108,12 +108,7 @@ int Daemon::Reconfigure(const SystemConfig& next, uint32_t node_id, std::string*
   r = view_.Start(next, node_id, kind, opt_.force_udp, &segment_, &transport_, &auth_, gid_, error);
   if (r != 0) return r;
   // The send cycle (handoffs_.send_cycle) stays as configured at start: ReloadRefusal.
-  const uint64_t now = platform::MonotonicNs();
-  send_.StartPeriods(now);
-  store::SegmentHeader* h = segment_.header();
-  h->daemon_pid.store(static_cast<int32_t>(platform::ProcessId()), std::memory_order_release);
-  h->daemon_heartbeat_ns.store(now, std::memory_order_release);
-  handoffs_.running.store(true);
+  StartRunning();
   return 0;
 }
 

@@ -109,6 +109,16 @@ class ReloadTest : public testing::ReceivingDaemonTest {
     daemon_.segment().header()->tx_doorbell.fetch_add(1);
     platform::FutexWake(&daemon_.segment().header()->tx_doorbell, 1);
   }
+  // A reload that changes only a local setting (the segment stays), then both threads again.
+  void ReconfigureLocalOnlyAndRun() {
+    next_ = cfg_;
+    next_.network.peer_timeout_ms = 900;
+    std::string err;
+    ASSERT_EQ(daemon_.Reconfigure(next_, 0, &err), 0) << err;
+    ASSERT_TRUE(daemon_.adopted_segment());
+    rx_ = std::thread([this] { daemon_.RunRx(); });
+    StartTx();
+  }
   bool WaitPosTx(uint64_t n) {
     const store::SignalStats& st = daemon_.segment().stats(kPos);
     for (int i = 0; i < 500 && st.tx.load() + st.coalesced.load() < n; ++i) usleep(2000);
@@ -155,13 +165,7 @@ TEST_F(ReloadTest, ValuesWrittenDuringTheReloadStillLeave) {
   WritePos(2.0);
   WritePos(3.0);
   WritePos(4.0);
-  next_ = cfg_;
-  next_.network.peer_timeout_ms = 900;
-  std::string err;
-  ASSERT_EQ(daemon_.Reconfigure(next_, 0, &err), 0) << err;
-  ASSERT_TRUE(daemon_.adopted_segment());
-  rx_ = std::thread([this] { daemon_.RunRx(); });
-  StartTx();
+  ReconfigureLocalOnlyAndRun();
   const store::SignalStats& st = daemon_.segment().stats(kPos);
   ASSERT_TRUE(WaitPosTx(4)) << "tx " << st.tx.load() << " coalesced " << st.coalesced.load();
   EXPECT_EQ(st.tx.load(), 4u);  // 1 before; 2, 3 (caught up) and 4 after
@@ -185,13 +189,7 @@ TEST_F(ReloadTest, AValueTakenBeforeItsWriterPublishedLeavesOnceAcrossTheReload)
   EXPECT_EQ(daemon_.segment().stats(kPos).tx.load(), 1u);  // 2 leaves once published, not before
   StopBoth();
   EndWritePos(t);  // the writer goes on while the threads are stopped
-  next_ = cfg_;
-  next_.network.peer_timeout_ms = 900;
-  std::string err;
-  ASSERT_EQ(daemon_.Reconfigure(next_, 0, &err), 0) << err;
-  ASSERT_TRUE(daemon_.adopted_segment());
-  rx_ = std::thread([this] { daemon_.RunRx(); });
-  StartTx();
+  ReconfigureLocalOnlyAndRun();
   // Its first round (EndWritePos's dirty bit), done once it sleeps.
   for (int i = 0; i < 500 && !daemon_.segment().header()->tx_sleeping.load(); ++i) usleep(2000);
   ASSERT_TRUE(daemon_.segment().header()->tx_sleeping.load());

@@ -151,6 +151,17 @@ def _all_delivered(pair):
     return signal_stats(pair.stats("control"), "x"), signal_stats(pair.stats("planner"), "x")
 
 
+def _assert_every_value_accounted(w, r, prod, cons, gap):
+    """Neither app saw its segment retired; every write left or was coalesced; every value
+    that left arrived; the reader's longest gap around the reloads stays short."""
+    assert not w["retired"] and not r["retired"], (w["retired"], r["retired"])
+    assert prod["writes"] == w["written"] and prod["tx"] + prod["coalesced"] == prod["writes"], prod
+    # What the planner counts lost is exactly what control coalesced (a state written again
+    # before the send thread took it: machine load, also without a reload; test_coalesced.py).
+    assert cons["rx"] == prod["tx"] and cons["lost"] == prod["coalesced"], (prod, cons)
+    assert gap < (300 if SANITIZED else 100), gap
+
+
 def test_reload_with_a_broken_file_changes_nothing_and_says_file_line(tmp_path):
     cfg = tmp_path / "signals.xml"
     cfg.write_text(CONFIG)
@@ -181,13 +192,7 @@ def test_reload_with_a_broken_file_changes_nothing_and_says_file_line(tmp_path):
     print("\nbroken file: both reloads refused in %.0f ms; %d values written, %d coalesced, %d sent, %d received, "
           "%d lost; longest gap the reader saw around the reloads %.1f ms" % (
               took * 1000, prod["writes"], prod["coalesced"], prod["tx"], cons["rx"], cons["lost"], gap))
-    assert not w["retired"] and not r["retired"], (w["retired"], r["retired"])
-    assert prod["writes"] == w["written"] and prod["tx"] + prod["coalesced"] == prod["writes"], prod
-    # Every value that left arrived; what the planner counts lost is exactly what control
-    # coalesced (a state written again before the send thread took it: machine load, also
-    # without a reload; test_coalesced.py).
-    assert cons["rx"] == prod["tx"] and cons["lost"] == prod["coalesced"], (prod, cons)
-    assert gap < (300 if SANITIZED else 100), gap
+    _assert_every_value_accounted(w, r, prod, cons, gap)
 
 
 def test_reload_with_a_local_change_keeps_the_segment_and_every_value(tmp_path):
@@ -225,13 +230,7 @@ def test_reload_with_a_local_change_keeps_the_segment_and_every_value(tmp_path):
           "%d received, %d lost; longest gap the reader saw %.1f ms" % (
               took * 1000, "/".join("%.1f" % p for p in paused), prod["writes"], prod["coalesced"], cons["rx"],
               cons["lost"], gap))
-    assert not w["retired"] and not r["retired"], (w["retired"], r["retired"])
-    assert prod["writes"] == w["written"] and prod["tx"] + prod["coalesced"] == prod["writes"], prod
-    # Every value that left arrived; what the planner counts lost is exactly what control
-    # coalesced (a state written again before the send thread took it: machine load, also
-    # without a reload; test_coalesced.py).
-    assert cons["rx"] == prod["tx"] and cons["lost"] == prod["coalesced"], (prod, cons)
-    assert gap < (300 if SANITIZED else 100), gap
+    _assert_every_value_accounted(w, r, prod, cons, gap)
 
 
 def test_reload_with_a_signal_change_replaces_the_segment_without_old_values(tmp_path):

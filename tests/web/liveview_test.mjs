@@ -16,7 +16,11 @@ const WEB_URL = env("WEB_URL"), WS_URL = env("WS_URL"), NODE = env("CCOMM_NODE")
 // 12 s of tick = 1..1200 at 100 Hz: at the default --max-rate a 100 Hz signal must arrive
 // within the documented lag (issue 39: the passes locked onto its writes, p50 5.2 ms)
 const WRITER_RATE = 100, WRITER_COUNT = 1200;
-const LAG_P50_MS = 2;  // docs/integrations/liveview.md: 1-2 ms behind the node
+// docs/integrations/liveview.md: 1-2 ms behind the node on an idle machine. The check is
+// for the defect (passes locked onto the writes out of phase: p50 5.2-5.6 ms, half the
+// write period), with room for a loaded CI machine (2.20 ms measured in a fresh-clone run
+// beside QEMU boards): a timing figure is the benchmark's to claim, not this test's.
+const LAG_P50_MS = 4;
 
 let passed = 0, failed = 0, n = 0;
 async function check(name, fn) {

@@ -105,6 +105,19 @@ def test_gap_counts_values_written_between_two_passes(client):
     assert sent[-1][1]["value"] == 4 and sent[-1][1]["gap"] == 2 and s.gaps["tick"] == 2
 
 
+def test_gap_counts_a_first_value_replaced_before_the_first_pass_that_saw_it(client):
+    # drive_ok is written by no other test here: the view first sees it never written (seq 0);
+    # its first value, replaced before the next pass, is a gap (ccomm web's live test: 1 of
+    # 1200 values neither received nor counted).
+    s, sent = sampler(client, ["drive_ok"])
+    s.poll()
+    assert sent[-1][1]["status"] == "never" and sent[-1][1]["seq"] == 0
+    client.write("drive_ok", True)
+    client.write("drive_ok", False)
+    s.poll()
+    assert sent[-1][1]["seq"] == 2 and sent[-1][1]["gap"] == 1 and s.gaps["drive_ok"] == 1
+
+
 def test_going_stale_is_published_without_a_write(client):
     s, sent = sampler(client, ["wheel_pos"], keepalive=60.0)  # stale_after_ms=300
     client.write("wheel_pos", 0.5)

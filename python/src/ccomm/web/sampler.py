@@ -204,7 +204,9 @@ class Sampler:
     def _send(self, t: _Tracked, r: Reading, now: float) -> None:
         if r.seq != t.last_seq or t.signal.info.is_event:
             t.changes += 1
-        gap = r.seq - t.last_seq - 1 if t.last_seq > 0 and r.seq > t.last_seq + 1 else 0
+        # From the view's first message on (a signal never written has seq 0 then: its first
+        # value replaced before a pass is a gap too); values before the view attached are not.
+        gap = r.seq - t.last_seq - 1 if t.last_seq >= 0 and r.seq > t.last_seq + 1 else 0
         t.gaps += gap
         t.last_seq, t.last_status, t.last_sent = r.seq, r.status, now
         t.published += 1

@@ -151,6 +151,18 @@ def _all_delivered(pair):
     return signal_stats(pair.stats("control"), "x"), signal_stats(pair.stats("planner"), "x")
 
 
+def _start_with_apps(pair, write_s, read_s):
+    """Both ccommd, their segments' inodes, control's writer and the planner's reader
+    running for about write_s / read_s seconds, one second in."""
+    pair.start("control")
+    pair.start("planner")
+    inodes = {n: _segment_inode(pair, n) for n in ("control", "planner")}
+    writer = _writer(pair, write_s)
+    reader = _app(pair, "planner", "reader", read_s)
+    time.sleep(1.0)
+    return inodes, writer, reader
+
+
 def _assert_every_value_accounted(w, r, prod, cons, gap):
     """Neither app saw its segment retired; every write left or was coalesced; every value
     that left arrived; the reader's longest gap around the reloads stays short."""
@@ -166,12 +178,7 @@ def test_reload_with_a_broken_file_changes_nothing_and_says_file_line(tmp_path):
     cfg = tmp_path / "signals.xml"
     cfg.write_text(CONFIG)
     with NodePair(config=str(cfg)) as pair:
-        pair.start("control")
-        pair.start("planner")
-        inodes = {n: _segment_inode(pair, n) for n in ("control", "planner")}
-        writer = _writer(pair, 3.0)
-        reader = _app(pair, "planner", "reader", 3.5)
-        time.sleep(1.0)
+        inodes, writer, reader = _start_with_apps(pair, 3.0, 3.5)
         cfg.write_text(BROKEN)
         t0 = time.time()
         rc, out = _reload(pair, "planner")
@@ -199,12 +206,7 @@ def test_reload_with_a_local_change_keeps_the_segment_and_every_value(tmp_path):
     cfg = tmp_path / "signals.xml"
     cfg.write_text(CONFIG)
     with NodePair(config=str(cfg)) as pair:
-        pair.start("control")
-        pair.start("planner")
-        inodes = {n: _segment_inode(pair, n) for n in ("control", "planner")}
-        writer = _writer(pair, 3.0)
-        reader = _app(pair, "planner", "reader", 3.5)
-        time.sleep(1.0)
+        inodes, writer, reader = _start_with_apps(pair, 3.0, 3.5)
         cfg.write_text(LOCAL_ONLY)
         t0 = time.time()
         for node in ("planner", "control"):
@@ -237,12 +239,7 @@ def test_reload_with_a_signal_change_replaces_the_segment_without_old_values(tmp
     cfg = tmp_path / "signals.xml"
     cfg.write_text(CONFIG)
     with NodePair(config=str(cfg)) as pair:
-        pair.start("control")
-        pair.start("planner")
-        inodes = {n: _segment_inode(pair, n) for n in ("control", "planner")}
-        writer = _writer(pair, 4.0)
-        reader = _app(pair, "planner", "reader", 4.5)
-        time.sleep(1.0)
+        inodes, writer, reader = _start_with_apps(pair, 4.0, 4.5)
         cfg.write_text(NEW_SIGNAL)
         # The planner first: control still sends frames of the old configuration for 0.5 s.
         t_planner = time.time()

@@ -107,6 +107,22 @@ int ListShm(const char* prefix, char* first, size_t cap);
 /// not a regular file, -EFBIG if larger than `max_bytes` (its size in `size`), -EIO if
 /// a read failed (errno says why), or the -errno of opening it.
 int ReadRegularFile(const char* path, uint64_t max_bytes, std::string* text, uint64_t* size);
+/// Writes `text` to `path` whole or not at all: a temporary file (`path`.tmp) renamed over
+/// it, so a reader sees the old file or the new one, never half of one. 0 or -errno
+/// (the temporary file is removed then). Start-up and supervision only.
+int WriteFileAtomically(const char* path, const std::string& text);
+/// What tells a file apart from the one that replaced it (same name): device, file id,
+/// size and last write time. `valid` false if `path` cannot be examined.
+struct FileIdentity {
+  uint64_t dev = 0, ino = 0, size = 0;
+  int64_t mtime_ns = 0;
+  bool valid = false;
+};
+FileIdentity IdentifyFile(const char* path);
+/// Both examined and the same file, unchanged.
+inline bool SameFile(const FileIdentity& a, const FileIdentity& b) {
+  return a.valid && b.valid && a.dev == b.dev && a.ino == b.ino && a.size == b.size && a.mtime_ns == b.mtime_ns;
+}
 /// True if `name` matches the shell glob `pattern` (* ? [...], as fnmatch with no flags).
 bool GlobMatch(const char* pattern, const char* name);
 /// Hostname (for the default node name); false on error.

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/platform.h"
 #include "daemon/board_net.h"
 
 namespace ccomm {
@@ -32,23 +33,6 @@ int SetAddress(int fd, const char* ifname, unsigned long request, uint32_t netwo
   memcpy(&ifr.ifr_addr, &sin, sizeof sin);
   if (ioctl(fd, request, &ifr) != 0) {
     *error = Errno(std::string("cannot set the ") + what + " of " + ifname);
-    return -1;
-  }
-  return 0;
-}
-
-// Writes `text` to `path` whole or not at all (a half file would configure nothing).
-int WriteFileAtomically(const std::string& path, const std::string& text, std::string* error) {
-  const std::string tmp = path + ".tmp";
-  FILE* f = fopen(tmp.c_str(), "w");
-  if (!f) {
-    *error = Errno("cannot write " + tmp);
-    return -1;
-  }
-  const bool ok = fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (fclose(f) != 0 || !ok || rename(tmp.c_str(), path.c_str()) != 0) {
-    *error = Errno("cannot write " + path);
-    unlink(tmp.c_str());
     return -1;
   }
   return 0;
@@ -127,7 +111,12 @@ int ApplyBoardNet(const SystemConfig& cfg, const BoardNetPlan& plan, const std::
       *error = Errno("cannot create " + network_dir);
       return -1;
     }
-    if (WriteFileAtomically(path, BoardNetNetworkFile(cfg, plan), error) != 0) return -1;
+    // Whole or not at all: a half file would configure nothing.
+    const int w = platform::WriteFileAtomically(path.c_str(), BoardNetNetworkFile(cfg, plan));
+    if (w != 0) {
+      *error = "cannot write " + path + ": " + strerror(-w);
+      return -1;
+    }
     done->push_back(path + (plan.address.empty() ? " (DHCP, by systemd-networkd)" : ""));
   }
   return 0;

@@ -42,9 +42,10 @@ const char kUsage[] =
     "                           summaries the nodes exchange every <network summary_ms>\n"
     "  gen 20sim4c SIGNALS.XML [NODE] OUTDIR\n"
     "                           generate the 20-sim 4C I/O component for NODE (default: -n)\n"
-    "  record, replay, web, ros2 ...\n"
+    "  record, replay, web, ros2, deploy ...\n"
     "                           run the installed tool ccomm-COMMAND (see its --help):\n"
-    "                           MCAP recording and replay, live view, ROS 2 bridge\n"
+    "                           MCAP recording and replay, live view, ROS 2 bridge,\n"
+    "                           one signals.xml onto every board, switched at one instant\n"
     "\n"
     "Options:\n"
     "  -n, --node NAME          node to attach to (default: $CCOMM_NODE, else hostname)\n"
@@ -291,6 +292,7 @@ const char* MissingToolHint(const char* cmd) {
   return !strcmp(cmd, "ros2") ? "ccomm-ros2 is built when Cyclone DDS is found (Debian: cyclonedds-dev, cyclonedds-tools)"
          : (!strcmp(cmd, "record") || !strcmp(cmd, "replay")) ? "it comes with the Python package: pip install 'ccomm[record]'"
          : !strcmp(cmd, "web") ? "it comes with the Python package: pip install 'ccomm[web]'"
+         : !strcmp(cmd, "deploy") ? "it comes with the Python package: pip install ccomm"
          : nullptr;
 }
 }  // namespace

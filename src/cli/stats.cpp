@@ -8,6 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,18 @@ Snapshot Take(ccomm_client* c) {
   return n;
 }
 
+// This board's CLOCK_REALTIME minus its CLOCK_MONOTONIC (ccomm_now's clock, which frames'
+// send times and the peers' clock floors are on), the monotonic clock read on both sides:
+// what maps the floors to real time (ccomm deploy's clock offsets between boards).
+int64_t RealtimeOffsetNs() {
+  const uint64_t m0 = ccomm::platform::MonotonicNs();
+  // std::chrono's system_clock: CLOCK_REALTIME on Linux, the system time on Windows.
+  const int64_t rt = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::system_clock::now().time_since_epoch()).count();
+  const uint64_t m1 = ccomm::platform::MonotonicNs();
+  return rt - static_cast<int64_t>(m0 + (m1 - m0) / 2);
+}
+
 double Rate(uint64_t a, uint64_t b, double secs) { return secs > 0 ? static_cast<double>(b - a) / secs : 0; }
 double AgeMs(int64_t age_ns) { return age_ns < 0 ? -1.0 : static_cast<double>(age_ns) / 1e6; }
 
@@ -76,6 +89,7 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("},\"clock\":{\"state\":\"%s\",\"port_state\":%d,\"offset_ns\":%" PRId64
            ",\"path_delay_ns\":%" PRId64 "}", ccomm_clock_state_name(now.clock.state), now.clock.port_state,
            now.clock.offset_ns, now.clock.path_delay_ns);
+    printf(",\"realtime_offset_ns\":%" PRId64, RealtimeOffsetNs());
     printf(",\"peers\":[");
     bool first = true;
     for (const ccomm_peer_stats& ps : now.peers) {

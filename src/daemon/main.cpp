@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccommd: one per board. Loads signals.xml, creates the node's shared-memory segment,
 // forwards signals over raw Ethernet or UDP. Started by systemd (Type=notify).
+// Over 500 lines: the options, the start-up sequence and the main loop with its reload
+// states (now, or armed for an instant) share the I/O threads' handles; moving the reload
+// states into a type of their own is issue 37's next step.
 #include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
@@ -13,6 +16,7 @@
 #include <sys/stat.h>
 #endif
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -26,6 +30,7 @@
 #include "daemon/ptp_config.h"
 #include "daemon/sd_notify.h"
 #include "daemon/stop_request.h"
+#include "daemon/switch_request.h"
 #include "daemon/segment_builder.h"
 #include "daemon/service.h"
 #include "daemon/transport.h"
@@ -68,6 +73,12 @@ const char kUsage[] =
     "                        reload it and wait for the result (systemctl reload: ExecReload=);\n"
     "                        exit 0 applied, 1 invalid file or not applied (ccommd keeps running\n"
     "                        on the configuration it had; its log says why)\n"
+    "      --at T            with --reload: switch at instant T (seconds since the epoch, up to\n"
+    "                        9 decimals; CLOCK_REALTIME) to FILE.staged, checked by ccommd at\n"
+    "                        once; cancelled if FILE.staged is removed or changed before T;\n"
+    "                        once applied FILE.staged replaces FILE (old: FILE.previous).\n"
+    "                        Prints 'armed T', then 'switched T APPLIED' (ns); ccomm deploy's\n"
+    "                        second phase (ccomm-deploy(1))\n"
     "  -v, --verbose         more log output (notices about peers and restarts are on by default)\n"
     "  -q, --quiet           warnings and errors only\n"
     "  -h, --help            this text\n"
@@ -82,8 +93,26 @@ const char kUsage[] =
     "See ccommd(8), docs/config.md and docs/protocol.md.\n";
 
 #ifndef _WIN32
-// --board-net (board_net.h): waits up to 10 s for the node's interface (the network
-// driver may still be probing at boot), then configures it. 0 done, 1 no node / failed.
+// --board-net (board_net.h): waits up to kBoardNetWaitS for the node's interface (the
+// network driver may still be probing at boot: on a slow first boot, beside the SSH host
+// keys being made, an emulated board's eth0 came more than 10 s after this started),
+// then configures it. 0 done, 1 no node / failed. CCOMM_BOARD_NET_WAIT_S (0..600)
+// changes the bound (the tests' no-node case).
+constexpr uint64_t kBoardNetWaitS = 60;
+
+uint64_t BoardNetWaitS() {
+  const char* v = getenv("CCOMM_BOARD_NET_WAIT_S");
+  char* end = nullptr;
+  const unsigned long n = v && *v ? strtoul(v, &end, 10) : 0;
+  if (!v || !*v || *end || n > 600) {
+    if (v && *v)
+      ccomm::Log(ccomm::LogLevel::kWarning, "ccommd: CCOMM_BOARD_NET_WAIT_S='%s' is not 0..600; waiting %u s", v,
+                 static_cast<unsigned>(kBoardNetWaitS));
+    return kBoardNetWaitS;
+  }
+  return n;
+}
+
 int RunBoardNet(const ccomm::SystemConfig& cfg, const std::string& explicit_node, const char* explicit_from,
                 bool dry_run, const std::string& network_dir, bool network_dir_given) {
   using namespace ccomm;
@@ -100,7 +129,8 @@ int RunBoardNet(const ccomm::SystemConfig& cfg, const std::string& explicit_node
   }
   BoardNetPlan plan;
   std::string error;
-  const uint64_t t0 = platform::MonotonicNs(), limit_ns = 10ull * 1000 * 1000 * 1000;
+  const uint64_t wait_s = BoardNetWaitS();
+  const uint64_t t0 = platform::MonotonicNs(), limit_ns = wait_s * 1000 * 1000 * 1000;
   int r = 0;
   for (bool said = false;;) {
     char host[256] = "";
@@ -108,7 +138,9 @@ int RunBoardNet(const ccomm::SystemConfig& cfg, const std::string& explicit_node
     const bool last = platform::MonotonicNs() - t0 >= limit_ns;
     r = PlanBoardNet(cfg, name, from.c_str(), host, LocalInterfaces(), last, &plan, &error);
     if (r != 0) break;
-    if (!said) Log(LogLevel::kNotice, "board-net: this board's node or its interface is not there yet; waiting up to 10 s");
+    if (!said)
+      Log(LogLevel::kNotice, "board-net: this board's node or its interface is not there yet; waiting up to %u s",
+          static_cast<unsigned>(wait_s));
     said = true;
     platform::SleepNs(100ull * 1000 * 1000);
   }
@@ -222,40 +254,47 @@ std::string FirstLine(const std::string& text) { return text.substr(0, text.find
 
 enum class ReloadOutcome { kApplied, kRefused, kBroken };
 
-// SIGHUP (docs/usage.md, "Reload"): the file read and checked by the one parser while the
-// I/O threads go on with the running configuration; only a file that can be applied stops
-// them, for as long as Daemon::Reconfigure takes. kBroken: neither the new nor the old
-// configuration could be set up again (exit 3: systemd restarts ccommd).
-ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
-                     std::unique_ptr<ccomm::SystemConfig>* cfg, uint32_t* node, IoThreads* io) {
+// Why `path` cannot be the next configuration ("" if it can: then *next and *n are set).
+std::string ReloadProblem(const ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, const std::string& path,
+                          std::unique_ptr<ccomm::SystemConfig>* next, uint32_t* n) {
   using namespace ccomm;
-  const int requester = stop::ReloadRequester();
-  sd::NotifyReloading();
-  Log(LogLevel::kNotice, "reload: reading %s", opt.config_path.c_str());
-  auto next = std::unique_ptr<SystemConfig>(new SystemConfig);
+  next->reset(new SystemConfig);
   std::string error;
-  auto refuse = [&](const std::string& why) {
-    LogText(LogLevel::kError, why);
-    Log(LogLevel::kError, "reload failed: still forwarding on the configuration loaded before (hash %08x)",
-        (*cfg)->hash);
-    const std::string status = "forwarding on the old configuration; reload failed: " + FirstLine(why);
-    sd::NotifyReloaded(status.c_str());
-    stop::AnswerReload(requester, false);
-    return ReloadOutcome::kRefused;
-  };
-  if (!LoadConfig(opt.config_path, next.get(), &error)) return refuse(error);
-  const int n = next->FindNode(opt.node);
-  if (n < 0)
-    return refuse(opt.config_path + ": error: this board's node '" + opt.node +
-                  "' is not in the file any more (restart ccommd to be another node)");
-  const std::string why = daemon.ReloadRefusal(*next, static_cast<uint32_t>(n));
-  if (!why.empty()) return refuse(why);
-  const std::string fit = SegmentFitProblem(*next, static_cast<uint32_t>(n), store::SegmentName(opt.node));
-  if (!fit.empty()) return refuse(opt.config_path + ": error: " + fit);
+  if (!LoadConfig(path, next->get(), &error)) return error;
+  const int i = (*next)->FindNode(opt.node);
+  if (i < 0)
+    return path + ": error: this board's node '" + opt.node +
+           "' is not in the file any more (restart ccommd to be another node)";
+  *n = static_cast<uint32_t>(i);
+  const std::string why = daemon.ReloadRefusal(**next, *n);
+  if (!why.empty()) return why;
+  const std::string fit = SegmentFitProblem(**next, *n, store::SegmentName(opt.node));
+  if (!fit.empty()) return path + ": error: " + fit;
+  return "";
+}
 
+ReloadOutcome Refuse(const ccomm::SystemConfig& cfg, int requester, const std::string& why) {
+  using namespace ccomm;
+  LogText(LogLevel::kError, why);
+  Log(LogLevel::kError, "reload failed: still forwarding on the configuration loaded before (hash %08x)", cfg.hash);
+  const std::string status = "forwarding on the old configuration; reload failed: " + FirstLine(why);
+  sd::NotifyReloaded(status.c_str());
+  stop::AnswerReload(requester, stop::ReloadAnswer::kRefused);
+  return ReloadOutcome::kRefused;
+}
+
+// Puts `next` (checked by ReloadProblem) in place of *cfg; only this stops the I/O threads,
+// for as long as Daemon::Reconfigure takes. `late_ns` >= 0: a switch at an instant, begun
+// that long after it. kBroken: neither the new nor the old configuration could be set up
+// again (exit 3: systemd restarts ccommd).
+ReloadOutcome Apply(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, std::unique_ptr<ccomm::SystemConfig>* cfg,
+                    uint32_t* node, IoThreads* io, std::unique_ptr<ccomm::SystemConfig>* next, uint32_t n,
+                    int requester, int64_t late_ns) {
+  using namespace ccomm;
+  std::string error;
   const uint64_t t0 = platform::MonotonicNs();
   StopIo(daemon, io);
-  int r = daemon.Reconfigure(*next, static_cast<uint32_t>(n), &error);
+  int r = daemon.Reconfigure(**next, n, &error);
   if (r != 0) {
     const std::string failed = error;
     Log(LogLevel::kError, "reload: %s; setting the configuration before up again", failed.c_str());
@@ -265,20 +304,112 @@ ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
           error.c_str());
       return ReloadOutcome::kBroken;
     }
-    return refuse(opt.config_path + ": error: " + failed);
+    return Refuse(**cfg, requester, opt.config_path + ": error: " + failed);
   }
   if (StartIo(daemon, io) != 0) return ReloadOutcome::kBroken;
   const double paused_ms = static_cast<double>(platform::MonotonicNs() - t0) / 1e6;
-  const bool signals_changed = next->hash != (*cfg)->hash;
-  Log(LogLevel::kNotice, "reloaded %s: %zu signals, config hash %08x%s; segment %s; forwarding paused %.1f ms",
-      opt.config_path.c_str(), next->signals.size(), next->hash, signals_changed ? " (changed)" : " (same)",
+  const bool signals_changed = (*next)->hash != (*cfg)->hash;
+  std::string when;
+  if (late_ns >= 0) {
+    char late[48];
+    snprintf(late, sizeof late, "%.1f ms)", static_cast<double>(late_ns) / 1e6);
+    when = " (from " + switch_at::StagedPath(opt.config_path) + ", at the agreed instant + " + late;
+  }
+  Log(LogLevel::kNotice, "reloaded %s%s: %zu signals, config hash %08x%s; segment %s; forwarding paused %.1f ms",
+      opt.config_path.c_str(), when.c_str(), (*next)->signals.size(), (*next)->hash,
+      signals_changed ? " (changed)" : " (same)",
       daemon.adopted_segment() ? "kept (same layout)" : "replaced (the old one retired: applications reopen)",
       paused_ms);
-  cfg->swap(next);  // the parts now read *cfg; the old configuration goes
-  *node = static_cast<uint32_t>(n);
+  cfg->swap(*next);  // the parts now read *cfg; the old configuration goes
+  next->reset();
+  *node = n;
   sd::NotifyReloaded("forwarding");
-  stop::AnswerReload(requester, true);
+  stop::AnswerReload(requester, stop::ReloadAnswer::kApplied);
   return ReloadOutcome::kApplied;
+}
+
+// SIGHUP (docs/usage.md, "Reload"): the file read and checked by the one parser while the
+// I/O threads go on with the running configuration; only a file that can be applied stops them.
+ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
+                     std::unique_ptr<ccomm::SystemConfig>* cfg, uint32_t* node, IoThreads* io) {
+  using namespace ccomm;
+  const int requester = stop::ReloadRequester();
+  sd::NotifyReloading();
+  Log(LogLevel::kNotice, "reload: reading %s", opt.config_path.c_str());
+  std::unique_ptr<SystemConfig> next;
+  uint32_t n = 0;
+  const std::string why = ReloadProblem(daemon, opt, opt.config_path, &next, &n);
+  if (!why.empty()) return Refuse(**cfg, requester, why);
+  return Apply(daemon, opt, cfg, node, io, &next, n, requester, -1);
+}
+
+// A switch at an instant (switch_request.h), armed: checked, waiting for at_ns.
+struct PendingSwitch {
+  std::unique_ptr<ccomm::SystemConfig> cfg;
+  uint32_t node = 0;
+  uint64_t at_ns = 0;  // CLOCK_REALTIME
+  int requester = 0;
+  ccomm::platform::FileIdentity staged;
+};
+
+// Furthest ahead a switch may be armed: an instant farther away is a mistake, not a plan.
+constexpr uint64_t kSwitchHorizonNs = 600ull * 1000000000;
+
+void Cancel(PendingSwitch* p, const char* why) {
+  using namespace ccomm;
+  if (!p->cfg) return;
+  Log(LogLevel::kError, "reload: the switch to %s is cancelled: %s; still forwarding on the configuration it has",
+      p->cfg->path.c_str(), why);
+  stop::AnswerReload(p->requester, stop::ReloadAnswer::kRefused);
+  p->cfg.reset();
+}
+
+// kReloadAt: reads and checks CONFIG.staged now, answers "armed"; nothing else changes.
+void Arm(const ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, const ccomm::SystemConfig& cfg,
+         PendingSwitch* p) {
+  using namespace ccomm;
+  Cancel(p, "a newer switch was asked for");
+  const int requester = stop::ReloadRequester();
+  const std::string staged = switch_at::StagedPath(opt.config_path);
+  std::string why;
+  const uint64_t at = switch_at::ReadInstant(opt.config_path, &why);
+  const uint64_t now = platform::RealtimeNs();
+  if (at && at <= now) why = "the switch instant is already " + std::to_string((now - at) / 1000000) + " ms past";
+  if (at && at > now + kSwitchHorizonNs) why = "the switch instant is more than 10 minutes ahead";
+  if (!at || !why.empty()) {
+    Refuse(cfg, requester, switch_at::InstantPath(opt.config_path) + ": error: " + why);
+    return;
+  }
+  const platform::FileIdentity id = platform::IdentifyFile(staged.c_str());
+  uint32_t n = 0;
+  why = ReloadProblem(daemon, opt, staged, &p->cfg, &n);
+  if (!why.empty()) {
+    p->cfg.reset();
+    Refuse(cfg, requester, why);
+    return;
+  }
+  p->node = n;
+  p->at_ns = at;
+  p->requester = requester;
+  p->staged = id;
+  Log(LogLevel::kNotice, "reload: %s checked (%zu signals, config hash %08x); switching to it in %.3f s",
+      staged.c_str(), p->cfg->signals.size(), p->cfg->hash, static_cast<double>(at - now) / 1e9);
+  stop::AnswerReload(requester, stop::ReloadAnswer::kArmed);
+}
+
+// At the instant: the armed configuration goes in, unless its file went away or changed.
+ReloadOutcome Fire(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, std::unique_ptr<ccomm::SystemConfig>* cfg,
+                   uint32_t* node, IoThreads* io, PendingSwitch* p) {
+  using namespace ccomm;
+  const int64_t late = static_cast<int64_t>(platform::RealtimeNs() - p->at_ns);
+  if (!platform::SameFile(p->staged, platform::IdentifyFile(switch_at::StagedPath(opt.config_path).c_str()))) {
+    Cancel(p, "the staged file was removed or changed since it was checked (ccomm deploy aborted)");
+    return ReloadOutcome::kRefused;
+  }
+  sd::NotifyReloading();
+  const ReloadOutcome r = Apply(daemon, opt, cfg, node, io, &p->cfg, p->node, p->requester, late);
+  p->cfg.reset();
+  return r;
 }
 
 }  // namespace
@@ -298,10 +429,11 @@ int RunDaemon(int argc, char** argv) {
       {"board-net", no_argument, nullptr, 'B'}, {"dry-run", no_argument, nullptr, 'D'},
       {"network-dir", required_argument, nullptr, 'N'},
       {"ptp-socket", required_argument, nullptr, 'P'}, {"clock-config", no_argument, nullptr, 'K'},
-      {"reload", required_argument, nullptr, 'L'},
+      {"reload", required_argument, nullptr, 'L'}, {"at", required_argument, nullptr, 'A'},
       {nullptr, 0, nullptr, 0}};
   bool json = false, board_net = false, dry_run = false;
   int reload_pid = 0;
+  uint64_t switch_at_ns = 0;  // --at
   std::string network_dir = "/run/systemd/network";
   bool network_dir_given = false;
   // Under systemd every line gets its priority, also a usage error's (journalctl -p err).
@@ -339,6 +471,14 @@ int RunDaemon(int argc, char** argv) {
           return 2;
         }
         break;
+      case 'A':
+        switch_at_ns = switch_at::ParseInstant(optarg);
+        if (!switch_at_ns) {
+          Log(LogLevel::kError, "ccommd: --at takes seconds since the epoch (up to 9 decimals: date +%%s.%%N), "
+              "not '%s'", optarg);
+          return 2;
+        }
+        break;
       case 'B': board_net = true; break;
       case 'D': dry_run = true; break;
       case 'N':
@@ -369,6 +509,12 @@ int RunDaemon(int argc, char** argv) {
     Log(LogLevel::kError, "ccommd: --reload goes with none of --board-net, --check, --which-node, --clock-config");
     return 2;
   }
+  if (switch_at_ns && !reload_pid) {
+    Log(LogLevel::kError, "ccommd: --at goes with --reload PID");
+    return 2;
+  }
+  // The staged file is checked, not the one in place (it may not even exist yet).
+  if (switch_at_ns) return switch_at::Request(opt.config_path, reload_pid, switch_at_ns);
   if (board_net && (opt.check_only || opt.which_node || opt.clock_config)) {
     Log(LogLevel::kError, "ccommd: --board-net goes with none of --check, --which-node, --clock-config");
     return 2;
@@ -527,10 +673,26 @@ int RunDaemon(int argc, char** argv) {
 
   const uint64_t watchdog_ns = sd::WatchdogIntervalNs();
   uint64_t last_ping = 0, last_tx = 0, last_rx = 0;
+  PendingSwitch pending;
   for (;;) {
-    const stop::Request req = stop::Wait(10);
+    // 10 ms, or less up to an armed switch's instant (then it is met to the ms).
+    int wait_ms = 10;
+    if (pending.cfg) {
+      const uint64_t t = platform::RealtimeNs();
+      wait_ms = pending.at_ns <= t ? 0 : static_cast<int>(std::min<uint64_t>(10, (pending.at_ns - t) / 1000000));
+    }
+    const stop::Request req = stop::Wait(wait_ms);
     if (req == stop::Request::kStop) break;
-    if (req == stop::Request::kReload && Reload(daemon, opt, &cfg_owner, &node_id, &io) == ReloadOutcome::kBroken) {
+    ReloadOutcome outcome = ReloadOutcome::kRefused;
+    if (req == stop::Request::kReload) {
+      Cancel(&pending, "a reload was asked for");
+      outcome = Reload(daemon, opt, &cfg_owner, &node_id, &io);
+    } else if (req == stop::Request::kReloadAt) {
+      Arm(daemon, opt, *cfg_owner, &pending);
+    }
+    if (pending.cfg && platform::RealtimeNs() >= pending.at_ns)
+      outcome = Fire(daemon, opt, &cfg_owner, &node_id, &io, &pending);
+    if (outcome == ReloadOutcome::kBroken) {
       daemon.Shutdown();
       return 3;
     }
@@ -546,6 +708,7 @@ int RunDaemon(int argc, char** argv) {
     }
   }
   if (ccomm_steady_state_end) ccomm_steady_state_end();
+  Cancel(&pending, "ccommd stops");
   sd::NotifyStopping();
   Log(LogLevel::kInfo, "stopping");
   StopIo(daemon, &io);

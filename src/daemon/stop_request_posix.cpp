@@ -5,7 +5,8 @@
 // The reload answer: `ccommd --reload PID` sends SIGHUP by sigqueue with kReloadAsk as
 // its value and waits for SIGUSR1 from PID, whose value says applied (1) or not (0). Only
 // a SIGHUP carrying that value is answered: a plain kill -HUP's sender may be gone, and
-// SIGUSR1 would end whatever process has its pid now.
+// SIGUSR1 would end whatever process has its pid now. `--reload PID --at T` asks with
+// kReloadAtAsk and gets two answers: armed (2), then applied (1) or not (0).
 #include <errno.h>
 #include <pthread.h>
 #include <signal.h>
@@ -20,7 +21,8 @@ namespace ccomm {
 namespace stop {
 namespace {
 
-constexpr int kReloadAsk = 0x43524c44;  // "CRLD"
+constexpr int kReloadAsk = 0x43524c44;    // "CRLD"
+constexpr int kReloadAtAsk = 0x43524c41;  // "CRLA"
 constexpr int kAnswerSignal = SIGUSR1;
 
 sigset_t g_set;
@@ -42,8 +44,10 @@ Request Wait(int timeout_ms) {
   const int sig = sigtimedwait(&g_set, &info, &ts);
   if (sig == SIGTERM || sig == SIGINT) return Request::kStop;
   if (sig == SIGHUP) {
-    g_requester = info.si_code == SI_QUEUE && info.si_value.sival_int == kReloadAsk ? info.si_pid : 0;
-    return Request::kReload;
+    const bool queued = info.si_code == SI_QUEUE;
+    const bool at = queued && info.si_value.sival_int == kReloadAtAsk;
+    g_requester = queued && (at || info.si_value.sival_int == kReloadAsk) ? info.si_pid : 0;
+    return at ? Request::kReloadAt : Request::kReload;
   }
   return Request::kNone;
 }
@@ -52,24 +56,28 @@ void RequestStop() { kill(getpid(), SIGTERM); }
 
 int ReloadRequester() { return g_requester; }
 
-void AnswerReload(int requester, bool applied) {
+void AnswerReload(int requester, ReloadAnswer answer) {
   if (requester <= 0) return;
   union sigval v;
-  v.sival_int = applied ? 1 : 0;
+  v.sival_int = static_cast<int>(answer);
   if (sigqueue(requester, kAnswerSignal, v) != 0)
     Log(LogLevel::kWarning, "cannot answer the reload request of pid %d: %s", requester, strerror(errno));
 }
 
-int AskReload(int pid, int timeout_ms) {
+namespace {
+
+// Sends `ask` to pid and waits for its answers: kArmed (only with on_armed) restarts the
+// wait with done_timeout_ms; kApplied / kRefused end it.
+int Ask(int pid, int ask, int first_timeout_ms, int done_timeout_ms, void (*on_armed)(void*), void* ctx) {
   // Blocked before asking: the answer may come before sigtimedwait runs.
   sigset_t answer;
   sigemptyset(&answer);
   sigaddset(&answer, kAnswerSignal);
   pthread_sigmask(SIG_BLOCK, &answer, nullptr);
   union sigval v;
-  v.sival_int = kReloadAsk;
+  v.sival_int = ask;
   if (sigqueue(pid, SIGHUP, v) != 0) return -errno;
-  const uint64_t deadline = platform::MonotonicNs() + uint64_t(timeout_ms) * 1000000;
+  uint64_t deadline = platform::MonotonicNs() + uint64_t(first_timeout_ms) * 1000000;
   for (;;) {
     const uint64_t now = platform::MonotonicNs();
     if (now >= deadline) return -ETIMEDOUT;
@@ -77,9 +85,26 @@ int AskReload(int pid, int timeout_ms) {
     struct timespec ts = {static_cast<time_t>(left / 1000000000), static_cast<long>(left % 1000000000)};
     siginfo_t info = {};
     const int sig = sigtimedwait(&answer, &info, &ts);
-    if (sig == kAnswerSignal && info.si_pid == pid) return info.si_value.sival_int == 1 ? 1 : 0;
+    if (sig == kAnswerSignal && info.si_pid == pid) {
+      const int a = info.si_value.sival_int;
+      if (a == static_cast<int>(ReloadAnswer::kArmed) && on_armed) {
+        on_armed(ctx);
+        on_armed = nullptr;
+        deadline = platform::MonotonicNs() + uint64_t(done_timeout_ms) * 1000000;
+        continue;
+      }
+      return a == static_cast<int>(ReloadAnswer::kApplied) ? 1 : 0;
+    }
     if (sig < 0 && errno != EINTR && errno != EAGAIN) return -errno;
   }
+}
+
+}  // namespace
+
+int AskReload(int pid, int timeout_ms) { return Ask(pid, kReloadAsk, timeout_ms, 0, nullptr, nullptr); }
+
+int AskReloadAt(int pid, int armed_timeout_ms, int done_timeout_ms, void (*on_armed)(void*), void* ctx) {
+  return Ask(pid, kReloadAtAsk, armed_timeout_ms, done_timeout_ms, on_armed, ctx);
 }
 
 }  // namespace stop

@@ -58,8 +58,9 @@ void RequestStop() {
 
 // No reload on Windows (no SIGHUP): restart the service to load a new file.
 int ReloadRequester() { return 0; }
-void AnswerReload(int, bool) {}
+void AnswerReload(int, ReloadAnswer) {}
 int AskReload(int, int) { return -ENOSYS; }
+int AskReloadAt(int, int, int, void (*)(void*), void*) { return -ENOSYS; }
 
 }  // namespace stop
 }  // namespace ccomm

@@ -5,6 +5,7 @@ regression. Values written at the same moment (one control cycle) leave in one f
 from __future__ import annotations
 
 import argparse
+import array
 import ctypes
 import fnmatch
 import gc
@@ -23,6 +24,11 @@ from .client import Client, SignalInfo
 
 if TYPE_CHECKING:
     from .mcap_io.recording import Recording
+
+try:
+    import resource  # POSIX only: the page faults and preemptions of a replay
+except ImportError:  # Windows
+    resource = None  # type: ignore[assignment]
 
 EXAMPLES = """\
 examples:
@@ -164,7 +170,9 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
     waits = [0, 0]  # flushes that waited 1 ms or more for ccommd to take the previous step, their total ns
     t0 = timeline[0][0]
     span = timeline[-1][0] - t0
-    late: List[int] = []
+    # One slot per write, allocated before the timing starts: nothing grows in the loop
+    # (with --loop, the slots of the pass before are overwritten: the stats are of the last).
+    late = array.array("q", bytes(8 * len(timeline)))
     written = 0
     # Signals written since the last flush: a second value of one of them starts a new
     # step (flush first), so a replay that runs late still hands ccommd every value in its
@@ -199,7 +207,7 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
                 retries[0] += tries
             if r < 0:
                 raise error(r, f"writing signal {sid} failed")
-            late.append(now() - target)
+            late[written % len(late)] = now() - target
             written += 1
             if not quiet and now() - last_report >= 1_000_000_000:
                 last_report = now()
@@ -210,8 +218,27 @@ def replay(c: Client, timeline: List[Tuple[int, int, int, bytes]], rate: float, 
         if not loop:
             break
         start += int(span / rate) + int((span / max(len(timeline) - 1, 1)) / rate)
-    return written, late, {"waits_over_1ms": waits[0], "waited_ms": round(waits[1] / 1e6, 3),
+    return written, list(late[:min(written, len(late))]), {"waits_over_1ms": waits[0], "waited_ms": round(waits[1] / 1e6, 3),
                            "full_retries": retries[0]}
+
+
+def _usage() -> Dict[str, int]:
+    if resource is None:
+        return {"major_faults": 0, "minor_faults": 0, "preempted": 0}
+    u = resource.getrusage(resource.RUSAGE_SELF)
+    return {"major_faults": u.ru_majflt, "minor_faults": u.ru_minflt, "preempted": u.ru_nivcsw}
+
+
+def _lock_memory() -> bool:
+    """mlockall(MCL_CURRENT | MCL_FUTURE), as a real-time task does: no page of the
+    interpreter, the timeline or what the loop allocates is faulted in or out while it
+    times. False where not permitted (RLIMIT_MEMLOCK without CAP_IPC_LOCK)."""
+    if sys.platform != "linux":
+        return False
+    try:
+        return int(ctypes.CDLL(None).mlockall(1 | 2)) == 0
+    except (OSError, AttributeError):
+        return False
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -273,6 +300,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     gc.collect()
     gc.freeze()
     gc.disable()
+    locked = _lock_memory() if a.priority > 0 else False
+    before = _usage()
     try:
         written, late, why_late = replay(c, timeline, a.rate, a.loop, stop, a.quiet)
     except CcommError as e:
@@ -281,6 +310,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     finally:
         gc.enable()
         c.close()
+    # What else could make a write late: page faults that read a file (major), the CPU
+    # taken by another task (involuntary switches); said so a late replay says why.
+    why_late.update(memory_locked=locked, **{k: v - before[k] for k, v in _usage().items()})
     late.sort()
     stats = {"values": written, "signals": len(chosen), "late_p50_ns": _percentile(late, 0.5),
              "late_p99_ns": _percentile(late, 0.99), "late_max_ns": late[-1] if late else 0, **why_late}
@@ -288,7 +320,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(("\r" if sys.stderr.isatty() else "") + f"replay: wrote {written} values; timing error p50 {stats['late_p50_ns'] / 1e3:.0f} us, "
               f"p99 {stats['late_p99_ns'] / 1e3:.0f} us, max {stats['late_max_ns'] / 1e3:.0f} us; waited for "
               f"ccommd to take a step {why_late['waits_over_1ms']} times 1 ms or more ({why_late['waited_ms']} ms "
-              f"in all), {why_late['full_retries']} retries on a full event ring", file=sys.stderr)
+              f"in all), {why_late['full_retries']} retries on a full event ring; {why_late['major_faults']} major and "
+              f"{why_late['minor_faults']} minor page faults, preempted {why_late['preempted']} times"
+              f"{'' if locked else ' (memory not locked)'}", file=sys.stderr)
     if stats_file is not None:
         with stats_file:
             json.dump(stats, stats_file, indent=1)

@@ -4,7 +4,8 @@
 # qemu-tests: name: systemd reached its target without failed units, each board has its
 # qemu-tests: node's hostname and address (ccomm-board-net, by its MAC) and the real-time
 # qemu-tests: kernel, and ccommd finds each board's node (ccommd --which-node); a file in
-# qemu-tests: which no node is the board is a clear error.
+# qemu-tests: which no node is the board is a clear error. A board booted from the SD card
+# qemu-tests: (--card) came through U-Boot and the card's boot.scr, root on the card.
 # qemu-tests: timeout=120
 . "$(dirname "$0")/../lib/common.sh"
 
@@ -27,6 +28,15 @@ systemctl --failed --no-legend --plain')
 		check "$b: PREEMPT_RT kernel" grep -q PREEMPT_RT <<<"${f[4]}"
 	fi
 	note "$b: ${f[5]}"
+	if [ "$b" = "${QT_CARD_BOARD:-}" ]; then
+		# Booted from the SD card: U-Boot ran the card's boot.scr (its lines on the serial
+		# console), which loaded the card's kernel and gave it the card's root partition.
+		cl=$(vm "$b" 'cat /proc/cmdline')
+		note "$b: booted from the card: $cl"
+		check "$b: U-Boot ran the card's boot.scr (its 'ccomm: kernel /boot/zImage' line on the console)" \
+			grep -q 'ccomm: kernel /boot/zImage' "$QT_WORK/$b.console.log"
+		check "$b: the root file system is the card's root partition (root=PARTUUID=)" grep -q 'root=PARTUUID=' <<<"$cl"
+	fi
 done
 # A signals.xml in which no node is this board (other names, MACs and addresses): ccommd
 # says so and what it tried.

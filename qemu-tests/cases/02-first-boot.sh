@@ -35,14 +35,22 @@ networkctl list --no-legend eth0 2>/dev/null | awk "{print \$4, \$5}" || true')
 	if [ -n "$start" ] && [ -n "$active" ] && [ "$active" -gt 0 ]; then
 		ms=$(((active - start) / 1000))
 		note "$b: ccommd: start to active (READY=1) ${ms} ms"
-		check "$b: ccommd active within 5 s of its start (${ms} ms)" [ "$ms" -lt 5000 ]
+		# Under its 10 s wait for a node, so it did not wait (the check above says so too);
+		# the rest is the emulated board's own speed (3.9-5.6 s on a slow host, 1-3 s before).
+		check "$b: ccommd active within 9 s of its start (${ms} ms)" [ "$ms" -lt 9000 ]
 	else
 		fail "$b: ccommd never became active at boot (${f[8]})"
 	fi
 done
 first=${QT_BOARDS%% *}
 for b in $QT_BOARDS; do
-	check "$b: the same kernel command line as $first" [ "${cmdline[$b]}" = "${cmdline[$first]}" ]
+	# A board booted from the card (--card) gets its command line from the card's boot.scr,
+	# not from QEMU's -append: compared with the boards booted alike, here none.
+	if [ "$b" = "${QT_CARD_BOARD:-}" ] || [ "$first" = "${QT_CARD_BOARD:-}" ]; then
+		note "$b: booted another way than $first (the SD card through U-Boot): command lines not compared"
+	else
+		check "$b: the same kernel command line as $first" [ "${cmdline[$b]}" = "${cmdline[$first]}" ]
+	fi
 	check "$b: the same /etc/ccomm/signals.xml as $first" [ "${sums[$b]}" = "${sums[$first]}" ]
 done
 finish

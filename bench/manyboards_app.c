@@ -201,6 +201,31 @@ int main(int argc, char** argv) {
       s->stale = stale;
     }
   }
+  // The drain above is counted in cycles: an app the host held back runs them without
+  // sleeping and can end before a producer held back longer sent its last values. So go
+  // on reading, up to 5 x drain_ms of wall time from here (a starved app and ccommd need
+  // seconds on a saturated host), until every consumed signal holds the last value
+  // (cycles), fresh or already stale, and its ccommd took every value it wrote (sent or
+  // coalesced); ccommd's counters go on counting anyway.
+  for (const int64_t until = ccomm_now() + 5 * (int64_t)drain_ms * 1000000; ccomm_now() < until;) {
+    int pending = 0;
+    for (int i = 0; i < g_nconsumed; i++) {
+      Consumed* s = &g_consumed[i];
+      double v;
+      ccomm_info info;
+      if (s->last_value == (double)cycles) continue;
+      const int st = ccomm_read_double(c, s->id, &v, &info);
+      // Stale: no newer write came (the safe value, if the signal had one, is not a value).
+      if (st == CCOMM_FRESH || (st == CCOMM_STALE && !(info.flags & CCOMM_INFO_SAFE_VALUE))) s->last_value = v;
+      pending += s->last_value != (double)cycles;
+    }
+    for (int i = 0; i < g_nproduced; i++) {  // and its own last values taken by its ccommd
+      ccomm_signal_stats st;
+      if (ccomm_get_signal_stats(c, g_produced[i], &st) == 0) pending += st.tx + st.coalesced != st.writes;
+    }
+    if (!pending) break;
+    sleep_until(ccomm_now() + 1000000);
+  }
   atomic_store(&g_stop, 1);
   if (latency) pthread_join(reader, NULL);
 

@@ -215,7 +215,7 @@ def test_a_forged_future_stamp_makes_genuine_values_stale_one_heartbeat_interval
         code = ("import socket,sys; s=socket.socket(socket.AF_INET,socket.SOCK_DGRAM); s.bind(('10.42.0.1',0)); "
                 "s.sendto(bytes.fromhex(sys.argv[1]),('10.42.0.2',47841))")
         rx0 = pair.stats("planner")["counters"]["frames_rx"]
-        run(pair.exec_prefix("control") + ["python3", "-c", code, forged.hex()])
+        run(pair.exec_prefix("control") + [sys.executable, "-c", code, forged.hex()])
         t_forged = time.monotonic()
         assert wait_for(lambda: pair.stats("planner")["counters"]["frames_rx"] > rx0, 5)
         time.sleep(0.2)  # past one heartbeat interval (50 ms) and a CLI run

@@ -143,9 +143,10 @@ khz_run() {
 # as the reference: if it also lost values in every try, this machine cannot carry
 # 1 kHz right now and the zero-loss check is reported as skipped with the counts; the
 # bridge must still never lose more than that app, and the DDS leg nothing, in any try.
-dds_loss=0 ref_lost_every_try=1 bridge_worse=0
+dds_loss=0 ref_lost_every_try=1 bridge_worse=0 dds_losses=""
 for try in 1 2 3; do
   khz_run "$try"
+  dds_losses+="${dds_losses:+, }$KHZ_DDS_LOSS"
   [[ $KHZ_DDS_LOSS -ne 0 ]] && dds_loss=1
   [[ $KHZ_REF_LOSS -eq 0 ]] && ref_lost_every_try=0
   [[ $KHZ_LOSS -gt $KHZ_REF_LOSS ]] && bridge_worse=$((bridge_worse + 1))
@@ -161,7 +162,7 @@ else
   check "  ... every value once, in order, right values and source timestamps" \
     checks samples "$WORK/joints.jsonl" --n 10000 --type double --count 36 --mono-minus-wall "$(mono_minus_wall joints)"
 fi
-check "  ... in every try, every sample the bridge published reached the ROS 2 reader" bash -c "[[ $dds_loss -eq 0 ]]"
+check "  ... in every try, every sample the bridge published reached the ROS 2 reader (published - received: $dds_losses)" bash -c "[[ $dds_loss -eq 0 ]]"
 
 # ---- stale: cut the board link; the ROS 2 reader's deadline (50 ms) fires in time
 stale0=$(bridge_stat pos stale)

@@ -22,7 +22,7 @@ else()
   target_include_directories(ccomm_config SYSTEM PRIVATE ${RAPIDXML_INCLUDE_DIR})
 endif()
 
-add_library(ccomm_segment_builder STATIC daemon/segment_builder.cpp)
+add_library(ccomm_segment_builder STATIC daemon/engine/segment_builder.cpp)
 ccomm_core_target(ccomm_segment_builder)
 target_link_libraries(ccomm_segment_builder PUBLIC ccomm_store ccomm_config)
 
@@ -46,11 +46,11 @@ include(${_dm}/sources.cmake)
 list(TRANSFORM CCOMM_DAEMON_SOURCES PREPEND ${_dm}/)
 list(TRANSFORM CCOMM_DAEMON_WINDOWS_SOURCES PREPEND ${_dm}/)
 add_library(ccomm_daemon STATIC ${CCOMM_DAEMON_SOURCES} ${CCOMM_DAEMON_WINDOWS_SOURCES}
-            ${_dm}/auth_crypto_none.cpp ${_dm}/sd_notify_none.cpp)
+            ${_dm}/security/auth_crypto_none.cpp ${_dm}/service/sd_notify_none.cpp)
 ccomm_core_target(ccomm_daemon)
 target_link_libraries(ccomm_daemon PUBLIC ccomm_segment_builder ccomm_store ccomm_wire ccomm_config ccomm_platform
                       iphlpapi ws2_32)
-add_executable(ccommd ${_dm}/main.cpp)
+add_executable(ccommd ${_dm}/service/main.cpp)
 ccomm_core_target(ccommd)
 target_compile_definitions(ccommd PRIVATE CCOMM_VERSION="${PROJECT_VERSION}")
 target_link_libraries(ccommd PRIVATE ccomm_daemon)

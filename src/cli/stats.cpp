@@ -129,7 +129,7 @@ void Print(ccomm_client* c, const Snapshot* before, const Snapshot& now, bool js
     printf("clock: %s (ptp4l port state %d, offset %" PRId64 " ns)%s\n", ccomm_clock_state_name(now.clock.state),
            now.clock.port_state, now.clock.offset_ns,
            "; ages are local");
-  for (size_t i = 0; i < now.counters.size(); ++i) {  // send on the cycle (daemon/send_cycle.h, LaunchMode)
+  for (size_t i = 0; i < now.counters.size(); ++i) {  // send on the cycle (daemon/engine/send_cycle.h, LaunchMode)
     static const char* const kLaunch[] = {"off", "launch times (SO_TXTIME, ETF qdisc)",
                                           "sleeps until each instant (launch_time=\"sleep\")",
                                           "sleeps until each instant (no SO_TXTIME on this platform)",

@@ -8,8 +8,8 @@
 
 #include "ccomm/ccomm.hpp"
 #include "common/platform.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/segment.h"
-#include "daemon/segment_builder.h"
 #include "testing/test_config.h"
 
 extern "C" {

@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
+#include "common/platform.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/segment.h"
 #include "store/view.h"
-#include "common/platform.h"
-#include "daemon/segment_builder.h"
 #include "testing/test_config.h"
 
 namespace ccomm {

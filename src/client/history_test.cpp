@@ -12,7 +12,7 @@
 #include "ccomm/ccomm.h"
 #include "ccomm/ccomm.hpp"
 #include "common/platform.h"
-#include "daemon/segment_builder.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/segment.h"
 #include "testing/test_config.h"
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "common/platform.h"
-#include "daemon/segment_builder.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/segment.h"
 #include "store/view.h"
 #include "testing/test_config.h"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The system view, the applications' side: ccomm_view_* read the view object
-// (store/view.h) that ccommd writes from the node summaries (daemon/system_view_writer.h),
+// (store/view.h) that ccommd writes from the node summaries (daemon/engine/system_view_writer.h),
 // read-only, through the seqlock of each node record. Names come from the client's
 // segment through the public API.
 #include <errno.h>

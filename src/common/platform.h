@@ -148,7 +148,7 @@ void LogText(LogLevel level, const std::string& text);
 void SetLogVerbosity(LogLevel max_level);
 void SetLogPrefixes(bool sd_prefixes);
 /// Appends log lines to the file `path` instead of stderr (a Windows service has no
-/// stderr: service_windows.cpp). False if it cannot be opened.
+/// stderr: service/windows/service.cpp). False if it cannot be opened.
 bool SetLogFile(const char* path);
 
 }  // namespace ccomm

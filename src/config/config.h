@@ -45,7 +45,7 @@ struct RealtimeConfig {
   int priority = 0;   // SCHED_FIFO priority for ccommd's I/O threads; 0 = SCHED_OTHER
   int cpu = -1;       // CPU affinity for ccommd's I/O threads; -1 = any
   uint32_t spin_us = 0;  // busy-poll window after activity before sleeping (0 = pure event-driven)
-  // Send on the cycle (daemon/send_cycle.h): periodic frames leave at k * period +
+  // Send on the cycle (daemon/engine/send_cycle.h): periodic frames leave at k * period +
   // send_phase_us of a clock the boards share. 0 = off. Local policy (not in the hash).
   uint32_t send_cycle_us = 0;    // divides one second
   uint32_t send_phase_us = 0;    // < send_cycle_us
@@ -110,7 +110,7 @@ struct NetworkConfig {
 
 // <clock>: linuxptp between the boards (local policy, not in the hash: a wrong domain shows
 // as a clock that never syncs, not as refused frames). Parsed by clock_section.cpp;
-// ccommd --clock-config writes ptp4l's configuration from it (daemon/ptp_config.cpp).
+// ccommd --clock-config writes ptp4l's configuration from it (daemon/clock/ptp_config.cpp).
 struct ClockConfig {
   bool present = false;
   uint32_t domain = 0;                    // PTP domainNumber, 0..127

@@ -70,7 +70,7 @@ void Parser::CrossCheck(SystemConfig* cfg) {
 
   std::vector<std::pair<uint32_t, uint32_t>> mixed;  // node pairs already reported
   // ccommd opens one transport, its own node's, and reaches every peer with it
-  // (daemon/transport.h), so nodes that exchange signals must agree on it.
+  // (daemon/net/transport.h), so nodes that exchange signals must agree on it.
   // Reported once per pair of nodes.
   auto check_transport = [&](const SignalConfig& s, int producer, uint32_t c, int line) {
     if (producer < 0) return;

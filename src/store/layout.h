@@ -79,7 +79,7 @@ enum DaemonCounter : uint32_t {
   kSocketDrops,  // frames the kernel dropped at ccommd's socket (receive buffer full)
   kFramesWrongSource,  // UDP frames whose source address is not the sender's configured one
   kFramesForeign,  // ccomm frames of another transport, EtherType or UDP port (foreign_frames.h)
-  // Send on the cycle (daemon/send_cycle.h): rounds sent on an instant, rounds that woke
+  // Send on the cycle (daemon/engine/send_cycle.h): rounds sent on an instant, rounds that woke
   // after theirs, frames the ETF qdisc dropped, and the launch mode (a LaunchMode, not a count).
   kCycleRounds, kCycleLate, kCycleEtfDrops, kCycleLaunch,
   kDaemonCounterCount
@@ -198,13 +198,13 @@ struct alignas(kCacheLine) PeerStats {
   std::atomic<uint32_t> alive;            // 1 while heartbeats arrive within peer_timeout_ms
   std::atomic<uint32_t> last_seq;
   std::atomic<uint64_t> last_latency_ns;  // last frame's (arrival - send time); same-clock setups only
-  // Its clock as the receive path bounds it from its frames (daemon/peer_clock.h); these
+  // Its clock as the receive path bounds it from its frames (daemon/clock/peer_clock.h); these
   // fill what was padding, so the size and every offset stay as in layout 6.
   std::atomic<uint64_t> clock_floor_ns;     // int64: min(arrival - send) over the window
   std::atomic<uint64_t> frames_delayed;     // frames held >= 10 ms beyond that floor
   std::atomic<uint64_t> queue_delay_ns;     // the last frame's delay beyond the floor
   std::atomic<uint64_t> queue_delay_max_ns; // the largest so far
-  // This node's own entry only: its clock synchronisation (daemon/ptp_state.h).
+  // This node's own entry only: its clock synchronisation (daemon/clock/ptp_state.h).
   std::atomic<uint64_t> clock_state;        // ClockState | PTP port state << 8 | 1 << 16 once published
   std::atomic<uint64_t> clock_offset_ns;    // int64: ptp4l's offset from its master
   std::atomic<uint64_t> clock_path_delay_ns;  // int64: ptp4l's mean path delay (P2P)

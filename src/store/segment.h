@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // A node's shared-memory segment: created (or re-adopted) by ccommd from an image it
-// builds from the configuration (daemon/segment_builder.h), mapped by clients. See
+// builds from the configuration (daemon/engine/segment_builder.h), mapped by clients. See
 // layout.h for the invariants. The store knows nothing of the configuration.
 #pragma once
 

@@ -14,7 +14,7 @@
 #include <atomic>
 #include <thread>
 #include <unistd.h>
-#include "daemon/segment_builder.h"
+#include "daemon/engine/segment_builder.h"
 #include "testing/test_config.h"
 
 namespace ccomm {

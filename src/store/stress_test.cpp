@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "common/platform.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/reclaim.h"
 #include "store/segment.h"
-#include "daemon/segment_builder.h"
 #include "testing/test_config.h"
 
 namespace ccomm {

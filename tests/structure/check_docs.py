@@ -64,7 +64,7 @@ def production_age_error(root, bad):
 
 
 def frames_rx(root, bad):
-    src = read(root, "src/daemon/receive_path.cpp")
+    src = read(root, "src/daemon/engine/receive_path.cpp")
     summary = src[src.index("void ReceivePath::HandleSummary"):]
     summary = summary[:summary.index("\n}\n")]
     if "kFramesRx" not in summary:

@@ -19,8 +19,13 @@
 - OS calls the platform layer wraps (shared memory, memory locking, scheduling, CPU
   affinity, sleeping) are made only in its units, src/common/platform/: nowhere else
   under src/, tests included (FORBIDDEN_CALLS);
+- ccommd (src/daemon/) is rooms (ROOMS): each a folder with a README.md that says what it
+  owns, no source file outside them; a room's units include only the rooms it may use
+  (its tests aside); a room's platform code is in its posix/ and windows/ folders, and its
+  portable units include no OS header (PORTABLE_OS_HEADERS);
 - no two source files under src/ share a name (two system_view.cpp once meant two
-  different things), except the platform units and each program's main.cpp;
+  different things), except the platform units (src/common/platform/, and a room's posix/
+  and windows/ units of one interface) and each program's main.cpp;
 - signals.xml has one parser (src/config/): no other code uses an XML parser on it
   (tools read `ccommd --check FILE --json`), and the value types' names are tabled once
   (src/common/value_type.h; ccomm_type_name() gives them out).
@@ -69,6 +74,20 @@ TYPE_NAME_TABLES = {
                                "the C++ encoder",
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+# ccommd's rooms (src/daemon/README.md) and the rooms each may include.
+ROOMS = {
+    "engine": {"net", "clock", "security"},
+    "net": set(),
+    "clock": set(),
+    "security": set(),
+    "service": {"engine", "net", "clock", "security"},
+}
+PLATFORM_FOLDERS = ("posix", "windows")
+# OS headers a room's portable units may not include (<sys/types.h>, a C type header on
+# every platform, may be): their code belongs in the room's posix/ or windows/ folder.
+OS_HEADER = re.compile(r'^\s*#\s*include\s*<(sys/(?!types\.h)[\w/]+\.h|unistd\.h|linux/[\w/]+\.h|arpa/\w+\.h|'
+                       r'net/\w+\.h|netinet/\w+\.h|ifaddrs\.h|fcntl\.h|signal\.h|poll\.h|dlfcn\.h|sched\.h|'
+                       r'syslog\.h|pwd\.h|grp\.h|windows\.h|winsock2\.h|ws2tcpip\.h|iphlpapi\.h|mswsock\.h)>', re.M)
 
 
 def nm(path, *flags, types="TDBRWVtdbrwv"):
@@ -141,9 +160,18 @@ def application_includes(src, errors):
                                   % (rel, inc))
 
 
+def platform_unit(name):
+    """For a unit in a posix/ or windows/ folder: the folder above it and its name (the
+    interface it implements), else None."""
+    parts = name.split("/")
+    if len(parts) >= 3 and parts[-2] in PLATFORM_FOLDERS:
+        return "/".join(parts[:-2]), parts[-1]
+    return None
+
+
 def unique_file_names(src, errors):
     """A file's name says what it is: one name, one file (per-platform units excepted: the
-    same interface in src/common/platform/posix/ and .../windows/)."""
+    same interface in src/common/platform/posix/ and .../windows/, or in a room's)."""
     seen = {}
     for name in tracked_code(src):
         if not name.startswith("src/") or name.startswith("src/common/platform/") or \
@@ -151,6 +179,9 @@ def unique_file_names(src, errors):
             continue
         seen.setdefault(os.path.basename(name), []).append(name)
     for base, names in sorted(seen.items()):
+        units = {platform_unit(n) for n in names}
+        if len(names) > 1 and None not in units and len(units) == 1:
+            continue  # one interface, one unit per platform folder
         if len(names) > 1:
             errors.append("%s: %d files share the name (%s): name each after what it is"
                           % (base, len(names), ", ".join(names)))
@@ -169,6 +200,71 @@ def os_calls_in_platform_layer(src, errors):
                           % (name, code.count("\n", 0, m.start()) + 1, m.group(1), PLATFORM_DIR))
 
 
+# Folders of src/ no rule above is about, and why.
+OTHER_FOLDERS = {"common": "the platform layer (FORBIDDEN_CALLS) and shared basics: every module may use it",
+                 "include": "the public API (ccomm/ccomm.h, ccomm.hpp)",
+                 "testing": "test helpers for the unit tests (configurations, documents)"}
+
+
+def every_folder_known(src, errors):
+    """Every folder of src/ is a module a rule above is about (a new one must be placed)."""
+    known = set(BOTTOM) | set(UPPER) | set(APPLICATIONS) | set(OTHER_FOLDERS)
+    for entry in sorted(os.listdir(os.path.join(src, "src"))):
+        if os.path.isdir(os.path.join(src, "src", entry)) and entry not in known:
+            errors.append("src/%s/ is in no layer of tests/structure/check_layering.py (BOTTOM, UPPER, "
+                          "APPLICATIONS, OTHER_FOLDERS): say where it belongs" % entry)
+
+
+def daemon_rooms(src, errors):
+    """ccommd's rooms: the folders of ROOMS, each with its README.md; includes between
+    rooms as ROOMS allows (tests and their fixtures may include any room); no OS header
+    in a portable unit; platform folders only inside a room."""
+    ddir = os.path.join(src, "src", "daemon")
+    for entry in sorted(os.listdir(ddir)):
+        path = os.path.join(ddir, entry)
+        if os.path.isdir(path):
+            if entry not in ROOMS:
+                errors.append("src/daemon/%s/ is no room of ROOMS (tests/structure/check_layering.py): add it "
+                              "with what it may use, and to src/daemon/README.md" % entry)
+            elif not os.path.isfile(os.path.join(path, "README.md")):
+                errors.append("src/daemon/%s/ has no README.md saying what the room owns" % entry)
+        elif entry.endswith(C_CODE):
+            errors.append("src/daemon/%s is in no room: put it in the room whose job it is" % entry)
+    for room in sorted(ROOMS):
+        if not os.path.isdir(os.path.join(ddir, room)):
+            errors.append("src/daemon/%s/ (a room of ROOMS) is missing" % room)
+            continue
+        for root, dirs, files in os.walk(os.path.join(ddir, room)):
+            rel_dir = os.path.relpath(root, ddir).replace(os.sep, "/")
+            for d in dirs:
+                if d not in PLATFORM_FOLDERS and not d.endswith("_corpus"):
+                    errors.append("src/daemon/%s/%s/: a room holds its units and posix/, windows/ only"
+                                  % (rel_dir, d))
+            platform = rel_dir.split("/")[-1] in PLATFORM_FOLDERS
+            for fname in sorted(files):
+                if not fname.endswith(C_CODE):
+                    continue
+                rel = "src/daemon/%s/%s" % (rel_dir, fname)
+                text = open(os.path.join(root, fname), encoding="utf-8").read()
+                test = fname.endswith("_test.cpp") or fname.endswith(("_fixture.h", "_test_util.h"))
+                if not platform and not test:
+                    for m in OS_HEADER.finditer(text):
+                        errors.append("%s:%d includes <%s>: OS code of a room is in its posix/ or windows/ folder"
+                                      % (rel, text.count("\n", 0, m.start()) + 1, m.group(1)))
+                if test:
+                    continue
+                for inc in INCLUDE.findall(text):
+                    parts = inc.split("/")
+                    if parts[0] != "daemon" or len(parts) < 3:
+                        continue
+                    other = parts[1]
+                    if other != room and other not in ROOMS[room]:
+                        errors.append('%s includes "%s": room %s may use %s (ROOMS)'
+                                      % (rel, inc, room, ", ".join(sorted(ROOMS[room])) or "no other room"))
+                    if len(parts) > 3 and parts[2] in PLATFORM_FOLDERS and other != room:
+                        errors.append('%s includes "%s": a room\'s platform code is its own' % (rel, inc))
+
+
 def public_interfaces(src, errors):
     """A public interface is public only if it pulls in no internals."""
     for header in PUBLIC_INTERFACES:
@@ -185,6 +281,8 @@ def main():
     public_interfaces(src, errors)
     os_calls_in_platform_layer(src, errors)
     unique_file_names(src, errors)
+    daemon_rooms(src, errors)
+    every_folder_known(src, errors)
     one_parser_one_table(src, errors)
     # 1. Includes of the bottom modules.
     for module, allowed in BOTTOM.items():
@@ -239,7 +337,7 @@ def main():
     if not errors:
         print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
               "applications use the public API (and config/outline.h, common/platform_app.h); OS calls of the "
-              "platform layer only in its units; one file per name; one parser of signals.xml, one table of type names")
+              "platform layer only in its units; ccommd's rooms as ROOMS allows; one file per name; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 
 

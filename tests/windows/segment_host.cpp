@@ -11,7 +11,7 @@
 
 #include "common/platform.h"
 #include "config/config.h"
-#include "daemon/segment_builder.h"
+#include "daemon/engine/segment_builder.h"
 #include "store/segment.h"
 
 int main(int argc, char** argv) {

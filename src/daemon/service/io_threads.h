@@ -3,7 +3,7 @@
 // Daemon::RunRx) as ccommd starts them after Daemon::Start and again after each reload
 // (io_threads.cpp), and stops them for a stop or a reload: at once, not after the
 // receive thread's socket timeout. How the receive thread's blocking call is cut short is
-// the platform's (posix/io_threads.cpp: SIGUSR2; windows/io_threads.cpp: it is not, and a
+// the platform's (posix/io_interrupt.cpp: SIGUSR2; windows/io_interrupt.cpp: it is not, and a
 // stop waits up to recv_timeout_ms: there is no reload there).
 #pragma once
 
@@ -25,7 +25,7 @@ int StartIo(Daemon& daemon, IoThreads* io);
 /// whose values already count as sent.
 void StopIo(Daemon& daemon, IoThreads* io);
 
-// The platform's part (posix/ or windows/io_threads.cpp), for io_threads.cpp.
+// The platform's part (posix/ or windows/io_interrupt.cpp), for io_threads.cpp.
 /// Once, before the first receive thread starts: what lets JoinInterrupting cut its wait short.
 void PrepareIoInterrupt();
 /// Joins the receive thread `t`, cutting its blocking call short where the platform can.

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccommd: one per board. Loads signals.xml, creates the node's shared-memory segment,
 // forwards signals over raw Ethernet or UDP. Started by systemd (Type=notify).
-// Over 500 lines: the options, the start-up sequence and the main loop with its reload
-// states (now, or armed for an instant), which share the I/O threads (io_threads.h).
+// The options, the start-up sequence and the main loop; the loop's reload states are
+// reloader.h's, the I/O threads io_threads.h's.
 #include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
@@ -10,7 +10,6 @@
 #include <string.h>
 #include <time.h>
 
-#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -25,6 +24,7 @@
 #include "daemon/security/privileges.h"
 #include "daemon/service/board_net_mode.h"
 #include "daemon/service/io_threads.h"
+#include "daemon/service/reloader.h"
 #include "daemon/service/sd_notify.h"
 #include "daemon/service/service.h"
 #include "daemon/service/stop_request.h"
@@ -87,168 +87,6 @@ const char kUsage[] =
     "Exit status: 0 clean stop or valid config, 1 invalid config, 2 usage, 3 start-up failure.\n"
     "See ccommd(8), docs/config.md and docs/protocol.md.\n";
 
-
-std::string FirstLine(const std::string& text) { return text.substr(0, text.find('\n')); }
-
-enum class ReloadOutcome { kApplied, kRefused, kBroken };
-
-// Why `path` cannot be the next configuration ("" if it can: then *next and *n are set).
-std::string ReloadProblem(const ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, const std::string& path,
-                          std::unique_ptr<ccomm::SystemConfig>* next, uint32_t* n) {
-  using namespace ccomm;
-  next->reset(new SystemConfig);
-  std::string error;
-  if (!LoadConfig(path, next->get(), &error)) return error;
-  const int i = (*next)->FindNode(opt.node);
-  if (i < 0)
-    return path + ": error: this board's node '" + opt.node +
-           "' is not in the file any more (restart ccommd to be another node)";
-  *n = static_cast<uint32_t>(i);
-  const std::string why = daemon.ReloadRefusal(**next, *n);
-  if (!why.empty()) return why;
-  const std::string fit = SegmentFitProblem(**next, *n, store::SegmentName(opt.node));
-  if (!fit.empty()) return path + ": error: " + fit;
-  return "";
-}
-
-ReloadOutcome Refuse(const ccomm::SystemConfig& cfg, int requester, const std::string& why) {
-  using namespace ccomm;
-  LogText(LogLevel::kError, why);
-  Log(LogLevel::kError, "reload failed: still forwarding on the configuration loaded before (hash %08x)", cfg.hash);
-  const std::string status = "forwarding on the old configuration; reload failed: " + FirstLine(why);
-  sd::NotifyReloaded(status.c_str());
-  stop::AnswerReload(requester, stop::ReloadAnswer::kRefused);
-  return ReloadOutcome::kRefused;
-}
-
-// Puts `next` (checked by ReloadProblem) in place of *cfg; only this stops the I/O threads,
-// for as long as Daemon::Reconfigure takes. `late_ns` >= 0: a switch at an instant, begun
-// that long after it. kBroken: neither the new nor the old configuration could be set up
-// again (exit 3: systemd restarts ccommd).
-ReloadOutcome Apply(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, std::unique_ptr<ccomm::SystemConfig>* cfg,
-                    uint32_t* node, ccomm::IoThreads* io, std::unique_ptr<ccomm::SystemConfig>* next, uint32_t n,
-                    int requester, int64_t late_ns) {
-  using namespace ccomm;
-  std::string error;
-  const uint64_t t0 = platform::MonotonicNs();
-  StopIo(daemon, io);
-  int r = daemon.Reconfigure(**next, n, &error);
-  if (r != 0) {
-    const std::string failed = error;
-    Log(LogLevel::kError, "reload: %s; setting the configuration before up again", failed.c_str());
-    error.clear();
-    if (daemon.Reconfigure(**cfg, *node, &error) != 0 || StartIo(daemon, io) != 0) {
-      Log(LogLevel::kError, "reload: cannot set the configuration before up again either (%s): exiting",
-          error.c_str());
-      return ReloadOutcome::kBroken;
-    }
-    return Refuse(**cfg, requester, opt.config_path + ": error: " + failed);
-  }
-  if (StartIo(daemon, io) != 0) return ReloadOutcome::kBroken;
-  const double paused_ms = static_cast<double>(platform::MonotonicNs() - t0) / 1e6;
-  const bool signals_changed = (*next)->hash != (*cfg)->hash;
-  std::string when;
-  if (late_ns >= 0) {
-    char late[48];
-    snprintf(late, sizeof late, "%.1f ms)", static_cast<double>(late_ns) / 1e6);
-    when = " (from " + switch_at::StagedPath(opt.config_path) + ", at the agreed instant + " + late;
-  }
-  Log(LogLevel::kNotice, "reloaded %s%s: %zu signals, config hash %08x%s; segment %s; forwarding paused %.1f ms",
-      opt.config_path.c_str(), when.c_str(), (*next)->signals.size(), (*next)->hash,
-      signals_changed ? " (changed)" : " (same)",
-      daemon.adopted_segment() ? "kept (same layout)" : "replaced (the old one retired: applications reopen)",
-      paused_ms);
-  cfg->swap(*next);  // the parts now read *cfg; the old configuration goes
-  next->reset();
-  *node = n;
-  sd::NotifyReloaded("forwarding");
-  stop::AnswerReload(requester, stop::ReloadAnswer::kApplied);
-  return ReloadOutcome::kApplied;
-}
-
-// SIGHUP (docs/usage.md, "Reload"): the file read and checked by the one parser while the
-// I/O threads go on with the running configuration; only a file that can be applied stops them.
-ReloadOutcome Reload(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt,
-                     std::unique_ptr<ccomm::SystemConfig>* cfg, uint32_t* node, ccomm::IoThreads* io) {
-  using namespace ccomm;
-  const int requester = stop::ReloadRequester();
-  sd::NotifyReloading();
-  Log(LogLevel::kNotice, "reload: reading %s", opt.config_path.c_str());
-  std::unique_ptr<SystemConfig> next;
-  uint32_t n = 0;
-  const std::string why = ReloadProblem(daemon, opt, opt.config_path, &next, &n);
-  if (!why.empty()) return Refuse(**cfg, requester, why);
-  return Apply(daemon, opt, cfg, node, io, &next, n, requester, -1);
-}
-
-// A switch at an instant (switch_request.h), armed: checked, waiting for at_ns.
-struct PendingSwitch {
-  std::unique_ptr<ccomm::SystemConfig> cfg;
-  uint32_t node = 0;
-  uint64_t at_ns = 0;  // CLOCK_REALTIME
-  int requester = 0;
-  ccomm::platform::FileIdentity staged;
-};
-
-// Furthest ahead a switch may be armed: an instant farther away is a mistake, not a plan.
-constexpr uint64_t kSwitchHorizonNs = 600ull * 1000000000;
-
-void Cancel(PendingSwitch* p, const char* why) {
-  using namespace ccomm;
-  if (!p->cfg) return;
-  Log(LogLevel::kError, "reload: the switch to %s is cancelled: %s; still forwarding on the configuration it has",
-      p->cfg->path.c_str(), why);
-  stop::AnswerReload(p->requester, stop::ReloadAnswer::kRefused);
-  p->cfg.reset();
-}
-
-// kReloadAt: reads and checks CONFIG.staged now, answers "armed"; nothing else changes.
-void Arm(const ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, const ccomm::SystemConfig& cfg,
-         PendingSwitch* p) {
-  using namespace ccomm;
-  Cancel(p, "a newer switch was asked for");
-  const int requester = stop::ReloadRequester();
-  const std::string staged = switch_at::StagedPath(opt.config_path);
-  std::string why;
-  const uint64_t at = switch_at::ReadInstant(opt.config_path, &why);
-  const uint64_t now = platform::RealtimeNs();
-  if (at && at <= now) why = "the switch instant is already " + std::to_string((now - at) / 1000000) + " ms past";
-  if (at && at > now + kSwitchHorizonNs) why = "the switch instant is more than 10 minutes ahead";
-  if (!at || !why.empty()) {
-    Refuse(cfg, requester, switch_at::InstantPath(opt.config_path) + ": error: " + why);
-    return;
-  }
-  const platform::FileIdentity id = platform::IdentifyFile(staged.c_str());
-  uint32_t n = 0;
-  why = ReloadProblem(daemon, opt, staged, &p->cfg, &n);
-  if (!why.empty()) {
-    p->cfg.reset();
-    Refuse(cfg, requester, why);
-    return;
-  }
-  p->node = n;
-  p->at_ns = at;
-  p->requester = requester;
-  p->staged = id;
-  Log(LogLevel::kNotice, "reload: %s checked (%zu signals, config hash %08x); switching to it in %.3f s",
-      staged.c_str(), p->cfg->signals.size(), p->cfg->hash, static_cast<double>(at - now) / 1e9);
-  stop::AnswerReload(requester, stop::ReloadAnswer::kArmed);
-}
-
-// At the instant: the armed configuration goes in, unless its file went away or changed.
-ReloadOutcome Fire(ccomm::Daemon& daemon, const ccomm::DaemonOptions& opt, std::unique_ptr<ccomm::SystemConfig>* cfg,
-                   uint32_t* node, ccomm::IoThreads* io, PendingSwitch* p) {
-  using namespace ccomm;
-  const int64_t late = static_cast<int64_t>(platform::RealtimeNs() - p->at_ns);
-  if (!platform::SameFile(p->staged, platform::IdentifyFile(switch_at::StagedPath(opt.config_path).c_str()))) {
-    Cancel(p, "the staged file was removed or changed since it was checked (ccomm deploy aborted)");
-    return ReloadOutcome::kRefused;
-  }
-  sd::NotifyReloading();
-  const ReloadOutcome r = Apply(daemon, opt, cfg, node, io, &p->cfg, p->node, p->requester, late);
-  p->cfg.reset();
-  return r;
-}
 
 }  // namespace
 
@@ -364,7 +202,7 @@ int RunDaemon(int argc, char** argv) {
   }
   SetLogVerbosity(static_cast<LogLevel>(verbosity));
 
-  // The configuration in use; a reload replaces it (Reload above).
+  // The configuration in use; a reload replaces it (reloader.h).
   std::unique_ptr<SystemConfig> cfg_owner(new SystemConfig);
   SystemConfig& cfg = *cfg_owner;
   std::string error;
@@ -506,26 +344,11 @@ int RunDaemon(int argc, char** argv) {
 
   const uint64_t watchdog_ns = opt.watchdog_ns;
   uint64_t last_ping = 0, last_tx = 0, last_rx = 0;
-  PendingSwitch pending;
+  Reloader reloader(daemon, opt, std::move(cfg_owner), node_id, &io);
   for (;;) {
-    // 10 ms, or less up to an armed switch's instant (then it is met to the ms).
-    int wait_ms = 10;
-    if (pending.cfg) {
-      const uint64_t t = platform::RealtimeNs();
-      wait_ms = pending.at_ns <= t ? 0 : static_cast<int>(std::min<uint64_t>(10, (pending.at_ns - t) / 1000000));
-    }
-    const stop::Request req = stop::Wait(wait_ms);
+    const stop::Request req = stop::Wait(reloader.WaitMs());
     if (req == stop::Request::kStop) break;
-    ReloadOutcome outcome = ReloadOutcome::kRefused;
-    if (req == stop::Request::kReload) {
-      Cancel(&pending, "a reload was asked for");
-      outcome = Reload(daemon, opt, &cfg_owner, &node_id, &io);
-    } else if (req == stop::Request::kReloadAt) {
-      Arm(daemon, opt, *cfg_owner, &pending);
-    }
-    if (pending.cfg && platform::RealtimeNs() >= pending.at_ns)
-      outcome = Fire(daemon, opt, &cfg_owner, &node_id, &io, &pending);
-    if (outcome == ReloadOutcome::kBroken) {
+    if (reloader.Handle(req) == ReloadOutcome::kBroken) {
       daemon.Shutdown();
       return 3;
     }
@@ -541,7 +364,7 @@ int RunDaemon(int argc, char** argv) {
     }
   }
   if (ccomm_steady_state_end) ccomm_steady_state_end();
-  Cancel(&pending, "ccommd stops");
+  reloader.Cancel("ccommd stops");
   sd::NotifyStopping();
   Log(LogLevel::kInfo, "stopping");
   StopIo(daemon, &io);

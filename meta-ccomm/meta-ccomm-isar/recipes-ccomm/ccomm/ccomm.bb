@@ -28,7 +28,7 @@ def ccomm_version(d):
 # CCOMM_BUILD_TESTS, which packaging/debian turns off). What identifies its content comes
 # from scripts/build-image as CCOMM_SOURCE_ID (a hash of the same files, with this list),
 # so a changed tree rebuilds the packages and an unchanged one reuses them.
-CCOMM_PACKAGE_EXCLUDES = "meta-ccomm-isar meta-ccomm recipes-ccomm recipes-kernel qemu-tests tests"
+CCOMM_PACKAGE_EXCLUDES = "meta-ccomm recipes-ccomm recipes-kernel qemu-tests tests"
 CCOMM_SOURCE_ID ??= "unknown"
 do_prepare_build[vardeps] += "CCOMM_SOURCE_ID CCOMM_PACKAGE_EXCLUDES"
 do_prepare_build[dirs] = "${WORKDIR}"

@@ -113,6 +113,10 @@ class Monitor {
   uint8_t domain_ = 0;
   int fd_ = -1;
   uint16_t sequence_ = 0;
+  // Answers still to come for the last poll: the socket is read only while one is (no
+  // ptp4l, the usual case off a PTP network: sendto fails and the idle tick makes no
+  // system call for it).
+  uint8_t awaited_ = 0;
   uint64_t next_poll_ns_ = 0;
   uint64_t last_answer_ns_ = 0;  // 0: never
   bool have_status_ = false, have_port_ = false;

@@ -44,21 +44,25 @@ void Monitor::Poll(uint64_t now_ns) {
   if (path_.size() >= sizeof to.sun_path) return;
   memcpy(to.sun_path, path_.data(), path_.size());
   uint8_t msg[64];
+  awaited_ = 0;
   for (uint16_t id : {kIdTimeStatusNp, kIdPortDataSet}) {
     const size_t len = BuildGet(msg, sizeof msg, id, ++sequence_, domain_);
     // ENOENT / ECONNREFUSED: no ptp4l; the silence decides (Evaluate).
-    (void)sendto(fd_, msg, len, MSG_DONTWAIT | MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+    if (sendto(fd_, msg, len, MSG_DONTWAIT | MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&to), sizeof to) >= 0)
+      ++awaited_;
   }
 }
 
 void Monitor::Drain(uint64_t now_ns) {
-  if (fd_ < 0) return;
+  if (fd_ < 0 || awaited_ == 0) return;
   uint8_t buf[512];
   for (int i = 0; i < 16; ++i) {  // bounded: two answers a poll, and stray ones
     const ssize_t n = recv(fd_, buf, sizeof buf, MSG_DONTWAIT);
     if (n <= 0) return;
     Reply r;
-    if (ParseReply(buf, static_cast<size_t>(n), &r)) Answer(r, now_ns);
+    if (!ParseReply(buf, static_cast<size_t>(n), &r)) continue;
+    Answer(r, now_ns);
+    if (awaited_ > 0) --awaited_;
   }
 }
 

@@ -14,6 +14,7 @@
 #include "common/platform.h"
 #include "common/value_type.h"
 #include "store/freshness.h"
+#include "store/reclaim.h"
 #include "store/segment.h"
 
 using ccomm::store::RingCursor;
@@ -422,7 +423,12 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
   st::SegmentHeader* h = c->segment.header();
   // Register first, then look (see SegmentHeader::rx_waiters): a write this look
   // misses has seen us waiting and bumps the doorbell, so DoorbellWait returns at once.
+  // This process's share of rx_waiters is kept in its entry too, so that ccommd can take
+  // it back if the process dies waiting (layout.h, WaiterEntry); first rx_waiters, then
+  // the entry (and back in reverse), so that a take-back never exceeds what was added.
+  st::WaiterEntry* me = st::ClaimWaiterEntry(h, ccomm::platform::ProcessId());
   h->rx_waiters.fetch_add(1, std::memory_order_seq_cst);
+  if (me) me->waiting.fetch_add(1, std::memory_order_relaxed);
   uint32_t seen = h->rx_doorbell.load(std::memory_order_seq_cst);
   bool changed = ccomm::client::TakeChanges(c);
   const uint64_t deadline = ccomm::platform::MonotonicNs() + uint64_t(timeout_ms < 0 ? 0 : timeout_ms) * 1000000;
@@ -432,6 +438,7 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
     // After the look at rx_doorbell: a retirement after it also bumps the doorbell, so
     // the wait below returns at once (UnlinkThenRetire).
     if (Retired(c)) {
+      if (me) me->waiting.fetch_sub(1, std::memory_order_relaxed);
       h->rx_waiters.fetch_sub(1, std::memory_order_seq_cst);
       return CCOMM_E_RETIRED;
     }
@@ -445,6 +452,7 @@ int ccomm_wait(ccomm_client* c, int timeout_ms) {
     seen = h->rx_doorbell.load(std::memory_order_seq_cst);
     changed = ccomm::client::TakeChanges(c);
   }
+  if (me) me->waiting.fetch_sub(1, std::memory_order_relaxed);
   h->rx_waiters.fetch_sub(1, std::memory_order_seq_cst);
   return changed ? 1 : 0;
 }

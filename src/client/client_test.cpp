@@ -4,8 +4,11 @@
 #include "ccomm/ccomm.hpp"
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <atomic>
@@ -15,6 +18,7 @@
 
 #include "common/platform.h"
 #include "daemon/engine/segment_builder.h"
+#include "store/reclaim.h"
 #include "store/segment.h"
 #include "store/view.h"
 #include "testing/test_config.h"
@@ -412,6 +416,44 @@ TEST_F(ClientTest, CppErrorIsClearedByASuccessfulSignal) {
   EXPECT_EQ(c.error(), CCOMM_E_TYPE);
   EXPECT_TRUE((c.signal<std::array<int32_t, 3>>("arr").valid()));
   EXPECT_EQ(c.error(), 0);
+}
+
+// An application killed while it waits in ccomm_wait() leaves its wait registered: before
+// the waiter entries, rx_waiters stayed raised for good, and every write on the node made a
+// FUTEX_WAKE from then on (found by the syscalls step). ccommd's scan takes it back; a
+// live waiter's wait is left alone.
+TEST_F(ClientTest, WaitOfAProcessThatDiedWaitingIsTakenBack) {
+  store::SegmentHeader* h = seg_a_.header();
+  ASSERT_EQ(h->rx_waiters.load(), 0u);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ccomm_client* c = nullptr;
+    if (ccomm_open("a", 0, &c) != 0) _exit(2);
+    ccomm_wait(c, 0);  // "changed since the open"
+    ccomm_wait(c, 60000);
+    _exit(0);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (h->rx_waiters.load() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(h->rx_waiters.load(), 1u);
+  EXPECT_EQ(store::ReclaimDeadWaiters(h), 0u);  // alive: nothing taken
+  EXPECT_EQ(h->rx_waiters.load(), 1u);
+  kill(child, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_EQ(h->rx_waiters.load(), 1u);  // what it left behind
+  EXPECT_EQ(store::ReclaimDeadWaiters(h), 1u);
+  EXPECT_EQ(h->rx_waiters.load(), 0u);
+  for (const store::WaiterEntry& e : h->waiters) EXPECT_NE(e.pid.load(), static_cast<uint32_t>(child));
+  // A waiter of this process (a thread) registers in its own entry and ends its wait itself.
+  ccomm_client* c = nullptr;
+  ASSERT_EQ(ccomm_open("a", 0, &c), 0);
+  ccomm_wait(c, 0);
+  EXPECT_EQ(ccomm_wait(c, 20), 0);  // nothing changed: timed out
+  EXPECT_EQ(h->rx_waiters.load(), 0u);
+  ccomm_close(c);
 }
 
 // A consumer asleep in ccomm_wait() when ccommd replaces the segment (new configuration)

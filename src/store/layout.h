@@ -25,12 +25,22 @@ static_assert(std::atomic<uint64_t>::is_always_lock_free, "shared-memory atomics
 static_assert(std::atomic<uint32_t>::is_always_lock_free, "shared-memory atomics must be lock-free");
 
 constexpr uint32_t kSegmentMagic = 0x43435348;  // "CCSH"
-constexpr uint32_t kLayoutVersion = 7;
+constexpr uint32_t kLayoutVersion = 8;
 constexpr size_t kCacheLine = 64;
 constexpr uint32_t kStateSlots = 4;  // copies per state signal; see state_slot.h
 constexpr size_t kNameBytes = 64;
 
 enum SegmentState : uint32_t { kInitializing = 0, kReady = 1, kRetired = 2 };
+
+// Who waits in ccomm_wait(), per process: a process that dies waiting leaves its count
+// here, and ccommd takes it back from rx_waiters (reclaim.h, ReclaimDeadWaiters); else
+// rx_waiters stays raised and every writer of the node makes a FUTEX_WAKE per write from
+// then on. A process that finds no free entry waits counted in rx_waiters only.
+constexpr uint32_t kWaiterEntries = 32;
+struct WaiterEntry {
+  std::atomic<uint32_t> pid;      // 0: free; claimed by CAS, freed by ccommd when the process is gone
+  std::atomic<uint32_t> waiting;  // that process's waits in progress (its share of rx_waiters)
+};
 
 struct alignas(kCacheLine) SegmentHeader {
   uint32_t magic;
@@ -67,6 +77,8 @@ struct alignas(kCacheLine) SegmentHeader {
   // write is never missed, and writers do not share a line when nobody waits.
   alignas(kCacheLine) std::atomic<uint32_t> rx_doorbell;
   std::atomic<uint32_t> rx_waiters;
+  // Apart from the doorbell's line: touched only as a wait begins and ends.
+  alignas(kCacheLine) WaiterEntry waiters[kWaiterEntries];
 
   // Daemon-wide counters (frames rejected by reason etc.), see DaemonStats.
   alignas(kCacheLine) std::atomic<uint64_t> daemon_counters[32];

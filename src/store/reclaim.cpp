@@ -69,5 +69,34 @@ size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspect
   return reclaimed;
 }
 
+WaiterEntry* ClaimWaiterEntry(SegmentHeader* h, uint32_t pid) {
+  WaiterEntry* free_entry = nullptr;
+  for (WaiterEntry& e : h->waiters) {
+    const uint32_t owner = e.pid.load(std::memory_order_acquire);
+    if (owner == pid) return &e;
+    if (owner == 0 && !free_entry) free_entry = &e;
+  }
+  for (WaiterEntry* e = free_entry; e && e < h->waiters + kWaiterEntries; ++e) {
+    uint32_t expected = 0;
+    if (e->pid.compare_exchange_strong(expected, pid, std::memory_order_acq_rel)) return e;
+    if (expected == pid) return e;  // another thread of this process claimed it first
+  }
+  return nullptr;
+}
+
+uint32_t ReclaimDeadWaiters(SegmentHeader* h) {
+  uint32_t taken = 0;
+  for (WaiterEntry& e : h->waiters) {
+    const uint32_t pid = e.pid.load(std::memory_order_acquire);
+    if (pid == 0 || platform::ProcessAlive(pid)) continue;
+    // Gone: nothing of it changes `waiting` any more.
+    const uint32_t n = e.waiting.exchange(0, std::memory_order_acq_rel);
+    if (n) h->rx_waiters.fetch_sub(n, std::memory_order_seq_cst);
+    taken += n;
+    e.pid.store(0, std::memory_order_release);
+  }
+  return taken;
+}
+
 }  // namespace store
 }  // namespace ccomm

@@ -37,5 +37,15 @@ size_t SlotCount(const Segment& s);
 /// SlotCount(s) entries. Makes one kill(pid, 0) per odd slot with a known owner.
 size_t ReclaimAbandonedSlots(const Segment& s, std::vector<SlotSuspect>* suspects);
 
+/// The waiter entry (layout.h, WaiterEntry) of process `pid`, claimed if it has none;
+/// nullptr when all are taken by live or not yet reclaimed processes. Client side, as a
+/// wait begins (a scan of kWaiterEntries entries, no system call).
+WaiterEntry* ClaimWaiterEntry(SegmentHeader* h, uint32_t pid);
+/// ccommd, about once a second: for each entry whose process is gone, its waits are taken
+/// back from rx_waiters and the entry freed. Returns the waits taken back. One
+/// kill(pid, 0) per claimed entry. A process killed between registering in rx_waiters and
+/// in its entry (two instructions) leaves one wait behind, as before this existed.
+uint32_t ReclaimDeadWaiters(SegmentHeader* h);
+
 }  // namespace store
 }  // namespace ccomm

@@ -56,6 +56,9 @@ void Supervisor::Tick(uint64_t now) {
     next_reclaim_ns_ = now + 1000000000ull;
     size_t freed = store::ReclaimAbandonedSlots(ctx_.segment, &reclaim_suspects_);
     if (freed) h->daemon_counters[store::kSlotsReclaimed].fetch_add(freed, std::memory_order_relaxed);
+    if (const uint32_t waits = store::ReclaimDeadWaiters(h))
+      Log(LogLevel::kNotice, "took back %u wait(s) of an application that died in ccomm_wait: writers on this "
+          "node no longer wake it", waits);
   }
   if (now >= next_drops_ns_ && ctx_.transport.ops) {
     // Frames lost before ccommd saw them (its receive thread starved, buffer full):

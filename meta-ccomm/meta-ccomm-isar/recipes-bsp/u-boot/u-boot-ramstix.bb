@@ -15,7 +15,7 @@ LIC_FILES_CHKSUM = "file://${LAYERDIR_core}/licenses/COPYING.GPLv2;md5=751419260
 
 inherit dpkg
 
-FILESEXTRAPATHS:prepend := "${THISDIR}/../../../meta-ccomm/bsp/u-boot-overo:"
+FILESEXTRAPATHS:prepend := "${CCOMM_TOPDIR}/meta-ccomm/bsp/u-boot-overo:"
 SRC_URI = "apt://u-boot file://0001-omap3-ccomm-ramstix-board.patch file://boot.cmd"
 PV = "2023.01"
 S = "${WORKDIR}/u-boot-src"

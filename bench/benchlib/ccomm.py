@@ -18,6 +18,7 @@ import os
 import shutil
 import signal
 import subprocess
+import threading
 import time
 
 from . import procs, results
@@ -316,6 +317,68 @@ def placed(argv, prio, cpus):
     if cpus:
         out += ["taskset", "-c", ",".join(str(c) for c in cpus)]
     return out + list(argv)
+
+
+class DaemonCpuSampler:
+    """Each ccommd's CPU time (schedstat ns, every thread) sampled every `every` seconds
+    on CLOCK_MONOTONIC while the applications run, so that their share of a measured
+    window the applications report (ccomm-latency's window_start_ns..window_end_ns, the
+    same clock) can be read off afterwards (between()), as a peer's own processes count
+    theirs: over that window, not the whole run."""
+
+    def __init__(self, daemons, names, every=0.02):
+        self.daemons, self.names, self.every = daemons, list(names), every
+        self.samples = []  # (t_ns, {name: cpu_ns})
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _take(self):
+        cpu = {}
+        for n in self.names:
+            c = self.daemons.cpu(n)
+            if c is None:
+                return
+            cpu[n] = c[1]
+        self.samples.append((time.monotonic_ns(), cpu))
+
+    def _run(self):
+        while not self._stop.is_set():
+            self._take()
+            self._stop.wait(self.every)
+
+    def __enter__(self):
+        self._take()
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+        self._take()
+        return False
+
+    def _at(self, name, t_ns):
+        s = self.samples
+        if not s:
+            return None
+        if t_ns <= s[0][0]:
+            return s[0][1][name]
+        for (t0, c0), (t1, c1) in zip(s, s[1:]):
+            if t0 <= t_ns <= t1:
+                f = (t_ns - t0) / float(t1 - t0) if t1 > t0 else 0.0
+                return c0[name] + f * (c1[name] - c0[name])
+        return s[-1][1][name]
+
+    def between(self, t0_ns, t1_ns):
+        """Every sampled ccommd's CPU ns between two CLOCK_MONOTONIC instants
+        (interpolated between samples), or None without samples."""
+        total = 0.0
+        for n in self.names:
+            a, b = self._at(n, t0_ns), self._at(n, t1_ns)
+            if a is None or b is None:
+                return None
+            total += b - a
+        return int(total)
 
 
 def run_apps(daemons, apps, timeout, probes=()):

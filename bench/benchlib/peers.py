@@ -272,7 +272,9 @@ def section(R, meta, problems):
              "machine: iceoryx2 (crate pinned in `bench/peers/iceoryx2`), busy-poll and listener/notifier, "
              "RTT/2. One-way rows share one clock (the namespaces share CLOCK_MONOTONIC). CPU per value: utime + "
              "stime of every process involved (peers: both processes, every thread, over their measured window; "
-             "ccomm: both applications over their whole lives plus both ccommds' threads over the same time) / "
+             "ccomm board to board the same: each application over its measured window, its send loop or its first "
+             "value received to its last, and both ccommds' threads over the span of the two windows, sampled every "
+             "20 ms; the on-target ping-pong rows count both processes' whole lives) / "
              "values delivered (a round trip delivers two). Throughput: 8 B one way at %s values/s offered "
              "(`0` = back to back; ccomm-latency sends periodically, so ccomm's sweep ends at the last non-zero "
              "rate), stopping at the first step that loses more than %g%% of the values (on this shared host a "
@@ -358,12 +360,20 @@ def why(R, check):
         return ("`%s` has no stage timestamps (RTT/2 rows are not split); its one-way rows above are." % cname)
     if c.get("cpu_ns") is not None:
         v = float(c.get("values") or 1)
-        return ("Per value, `%s` spent %s µs in its two application processes (whole lives: start-up, the 0.5 s "
-                "warm-up and the idle waits between values included) and %s µs in ccommd (both daemons, send and "
-                "receive threads, their 10 ms supervision tick and heartbeats included); `%s` spent %s + %s µs in "
-                "its two processes, counted over the measured window only. ccommd's share is the daemon design's "
-                "price: the peer's library sends from the application's own thread." % (
+        whole = ""
+        if c.get("cpu_ns_whole_per_value") is not None and c.get("cpu_basis") != "whole lives":
+            whole = (" Counted over the applications' whole lives instead (start-up, attach, memory locking and "
+                     "the leads between them included, as this table did before), `%s` took %s µs per value "
+                     "(%s in the applications, %s in ccommd)." % (
+                         cname, _us(c["cpu_ns_whole_per_value"]), _us(c.get("cpu_apps_ns_whole", 0) / v),
+                         _us(c.get("cpu_daemons_ns_whole", 0) / v)))
+        return ("Per value, `%s` spent %s µs in its two application processes and %s µs in ccommd (both daemons, "
+                "every thread: send and receive threads, the 10 ms supervision tick and heartbeats included), "
+                "each counted over the measured window as the peer's are (the sender's send loop, the receiver "
+                "from its first value to its last; the daemons over the span of both); `%s` spent %s + %s µs in "
+                "its two processes. ccommd's share is the daemon design's price: the peer's library sends from "
+                "the application's own thread.%s" % (
                     cname, _us(c.get("cpu_apps_ns", 0) / v), _us(c.get("cpu_daemons_ns", 0) / v), pname,
                     _us((p.get("cpu_ns") or 0) / float(p.get("values") or 1)),
-                    _us((p.get("cpu_ns_partner") or 0) / float(p.get("values") or 1))))
+                    _us((p.get("cpu_ns_partner") or 0) / float(p.get("values") or 1)), whole))
     return ""

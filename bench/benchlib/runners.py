@@ -181,7 +181,8 @@ def run_pair(ctx, case):
             apps = [("b", _app(ctx, d, "b", names[1], rate, dur + 2 * lead, case.name, sb, spin=spin, warmup=warm),
                      0.0),
                     ("a", _app(ctx, d, "a", names[0], rate, dur, case.name + "-src", sa, warmup=warm), lead)]
-        res = ccomm.run_apps(d, apps, dur + 30)
+        with ccomm.DaemonCpuSampler(d, names) as sampler:
+            res = ccomm.run_apps(d, apps, dur + 30)
         cpu_ns = _cpu_since(d, names, cpu0)
         after = _snapshot(d, names)
     dirn = ccomm.delta_stats(before, after, names[0], names[1])
@@ -189,11 +190,20 @@ def run_pair(ctx, case):
                  frames_per_cycle=_ratio(dirn["data_frames"], res["a"]["sent"]),
                  command=res["b"]["argv"] if o["mode"] == "oneway" else res["a"]["argv"],
                  daemon_command=d.argv[names[0]])
-    # CPU per value (issue 30, like the peers' rows): both applications' whole lives and both
-    # ccommds over the same time, per value delivered (a round trip delivers two).
+    # CPU per value, per value delivered (a round trip delivers two), counted as the peers'
+    # rows count theirs: each application over its measured window (its send loop, or from
+    # its first value received to its end: ccomm-latency's window_*), both ccommds over the
+    # span of the two windows (sampled, interpolated). The whole lives (start-up, attach,
+    # memory locking, the leads between the applications) are kept beside it (_whole).
     values = (res["a"].get("sent") or 0) * (2 if o["mode"] == "ping" else 1)
     if cpu_ns is not None and values:
-        extra.update(cpu_ns, values=values, cpu_ns_per_value=round(cpu_ns["cpu_ns"] / float(values)))
+        extra.update({k + "_whole": v for k, v in cpu_ns.items()})
+        extra.update(values=values, cpu_ns_whole_per_value=round(cpu_ns["cpu_ns"] / float(values)))
+        window = _window_cpu(res, sampler)
+        if window is not None:
+            extra.update(window, cpu_ns_per_value=round(window["cpu_ns"] / float(values)))
+        else:  # no windows reported: the whole lives, said so in the row
+            extra.update(cpu_ns, cpu_basis="whole lives", cpu_ns_per_value=extra["cpu_ns_whole_per_value"])
     if o["mode"] == "ping":
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["a"], sa, ctx.rawdir,
                                 metric="rtt_half", **extra)
@@ -201,6 +211,21 @@ def run_pair(ctx, case):
         row = ccomm.samples_row(case.name, o["transport"], 8 * k * count, rate, res["b"], sb, ctx.rawdir,
                                 **extra)
     return [row]
+
+
+def _window_cpu(res, sampler):
+    """{"cpu_ns", "cpu_apps_ns", "cpu_daemons_ns", "window_ns"} over the applications'
+    measured windows (see run_pair), or None when an application reported none."""
+    sides = [res[s] for s in ("a", "b") if s in res]
+    if any(not r.get("window_end_ns") for r in sides):
+        return None
+    start = min(r["window_start_ns"] for r in sides)
+    end = max(r["window_end_ns"] for r in sides)
+    daemons = sampler.between(start, end)
+    if daemons is None:
+        return None
+    apps = sum(int(r["window_cpu_ns"]) for r in sides)
+    return {"cpu_ns": apps + daemons, "cpu_apps_ns": apps, "cpu_daemons_ns": daemons, "window_ns": end - start}
 
 
 def _cpu_mark(d, names):

@@ -16,7 +16,7 @@ import tempfile
 import time
 import unittest
 
-from . import formatting, procs, results, targets
+from . import ccomm as ccomm_mod, formatting, procs, results, targets
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -119,6 +119,25 @@ class StatsTest(unittest.TestCase):
             rows = results.adopt_rows(results.load_rows(os.path.join(src, "rows.jsonl")), out)
             self.assertEqual(rows[0]["raw"], os.path.join("raw", "ccomm_x.tsv"))
             self.assertEqual(results.load_raw(os.path.join(out, rows[0]["raw"])), [(0, 100), (1, -1)])
+
+
+class DaemonCpuSamplerTest(unittest.TestCase):
+    """The daemons' share of a measured window, read off samples between them."""
+
+    def sampler(self, samples):
+        s = ccomm_mod.DaemonCpuSampler(None, ["a", "b"])
+        s.samples = samples
+        return s
+
+    def test_interpolates_between_samples(self):
+        s = self.sampler([(0, {"a": 0, "b": 0}), (100, {"a": 1000, "b": 10}), (200, {"a": 1000, "b": 30})])
+        self.assertEqual(s.between(50, 150), 500 + 15)   # a: 500 -> 1000, b: 5 -> 20
+        self.assertEqual(s.between(100, 200), 0 + 20)
+
+    def test_clamps_outside_the_samples(self):
+        s = self.sampler([(100, {"a": 10, "b": 0}), (200, {"a": 20, "b": 0})])
+        self.assertEqual(s.between(0, 1000), 10)
+        self.assertIsNone(self.sampler([]).between(0, 1))
 
 
 class PairedRatioTest(unittest.TestCase):

@@ -51,6 +51,11 @@ struct RealtimeResult {
 /// THREAD_PRIORITY_TIME_CRITICAL. The caller says what failed, in its own words. Not [rt].
 RealtimeResult SetUpRealtime(const RealtimeRequest& request);
 
+/// CPU time this process has used so far, every thread, user and system, in ns
+/// (CLOCK_PROCESS_CPUTIME_ID; Windows: GetProcessTimes). For a benchmark's own account of
+/// its measured window (ccomm-latency's cpu_ns). Not [rt]: a system call.
+uint64_t ProcessCpuNs();
+
 /// An exclusive lock on the object `name` (an shm name) that this process holds until it
 /// exits or dies, also while it is stopped (a SIGSTOPped ccommd keeps its node). Returns a
 /// handle to keep (>= 0), -EBUSY (the holder's pid in *holder_pid when known, else 0), or

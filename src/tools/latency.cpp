@@ -99,6 +99,9 @@ struct Shared {
   std::vector<int64_t> samples, last_hop;
   uint64_t first_k = 0, last_k = 0, received = 0;
   bool any = false;
+  // The receiving side's measured window (as a peer's sink counts it: from the first value
+  // to the end), for the CPU account: every complete value, warm-up included.
+  uint64_t rx_values = 0, rx_first_ns = 0, rx_first_cpu_ns = 0, rx_last_ns = 0;
 };
 
 // One clock reading per cycle, as a control loop takes it (ccomm_set_time): every value
@@ -189,6 +192,11 @@ void* Receiver(void* arg) {
     }
     if (!complete) continue;
     last_complete = k;
+    if (!s->rx_values++) {  // one system call, at the first value only
+      s->rx_first_ns = now;
+      s->rx_first_cpu_ns = ccomm::platform::ProcessCpuNs();
+    }
+    s->rx_last_ns = now;
     uint64_t kk = static_cast<uint64_t>(k);
     if (s->echo) {
       WriteAll(s, k);
@@ -360,6 +368,8 @@ int main(int argc, char** argv) {
   const uint64_t end = start + static_cast<uint64_t>(o.duration * 1e9);
   uint64_t next = Now();  // after the set-up above: a slow start must not fire the first cycles back to back
   uint64_t overruns = 0;  // cycles skipped because the loop woke a whole period late or more
+  // The sending side's measured window (as a peer's source counts it): the send loop.
+  const uint64_t tx_start_ns = Now(), tx_start_cpu_ns = ccomm::platform::ProcessCpuNs();
   for (uint64_t k = 1;; ++k) {
     next += period;
     ccomm::platform::SleepUntilNs(static_cast<int64_t>(next));
@@ -378,10 +388,24 @@ int main(int argc, char** argv) {
     WriteAll(&s, static_cast<double>(k));
     s.sent.fetch_add(1, std::memory_order_relaxed);
   }
+  const uint64_t tx_end_ns = Now(), tx_end_cpu_ns = ccomm::platform::ProcessCpuNs();
   // Let the last frames arrive.
   ccomm::platform::SleepNsInterruptible(200 * 1000 * 1000);
   s.stop = true;
   pthread_join(rx, nullptr);
+  // This process's CPU over its measured window, every thread (docs/performance.md, "CPU
+  // per value"): the send loop where it sends, else from its first value received to its
+  // last (its CPU to the end: the idle wait after the last value is in it); start-up,
+  // attach and memory locking are outside it, as they are for the peers.
+  const bool sends = !s.send.empty() && !s.echo;
+  uint64_t win_start = 0, win_end = 0, win_cpu = 0, win_values = 0;
+  if (sends) {
+    win_start = tx_start_ns, win_end = tx_end_ns, win_cpu = tx_end_cpu_ns - tx_start_cpu_ns;
+    win_values = s.sent.load();
+  } else if (s.rx_values) {
+    win_start = s.rx_first_ns, win_end = s.rx_last_ns, win_cpu = ccomm::platform::ProcessCpuNs() - s.rx_first_cpu_ns;
+    win_values = s.rx_values;
+  }
 
   std::vector<int64_t> v = s.samples;
   std::sort(v.begin(), v.end());
@@ -408,10 +432,12 @@ int main(int argc, char** argv) {
          "\"recv_signals\":%zu,\"sent\":%" PRIu64 ",\"received\":%" PRIu64 ",\"lost\":%" PRIu64
          ",\"min_ns\":%" PRId64 ",\"p50_ns\":%" PRId64 ",\"p90_ns\":%" PRId64 ",\"p99_ns\":%" PRId64
          ",\"p999_ns\":%" PRId64 ",\"max_ns\":%" PRId64 ",\"mean_ns\":%.0f,\"count\":%zu,"
-         "\"overruns\":%" PRIu64 ",\"first_k\":%" PRIu64 ",\"last_k\":%" PRIu64 "}\n",
+         "\"overruns\":%" PRIu64 ",\"first_k\":%" PRIu64 ",\"last_k\":%" PRIu64 ",\"window_start_ns\":%" PRIu64
+         ",\"window_end_ns\":%" PRIu64 ",\"window_cpu_ns\":%" PRIu64 ",\"window_values\":%" PRIu64 "}\n",
          ccomm::app::JsonText(o.label.c_str()).c_str(), o.mode.c_str(), ccomm_node_name(s.rx_client), o.rate, s.send.size(), s.recv.size(),
          s.sent.load(), s.received, lost, pct(0), pct(0.5), pct(0.9), pct(0.99), pct(0.999),
-         v.empty() ? -1 : v.back(), mean, v.size(), overruns, s.first_k, s.last_k);
+         v.empty() ? -1 : v.back(), mean, v.size(), overruns, s.first_k, s.last_k, win_start, win_end, win_cpu,
+         win_values);
   ccomm_close(s.tx_client);
   ccomm_close(s.rx_client);
   return 0;

@@ -59,5 +59,11 @@ RealtimeResult SetUpRealtime(const RealtimeRequest& request) {
   return result;
 }
 
+uint64_t ProcessCpuNs() {
+  struct timespec ts;
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
 }  // namespace platform
 }  // namespace ccomm

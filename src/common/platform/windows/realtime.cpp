@@ -72,5 +72,14 @@ RealtimeResult SetUpRealtime(const RealtimeRequest& request) {
   return result;
 }
 
+uint64_t ProcessCpuNs() {
+  FILETIME created, exited, kernel, user;
+  if (!GetProcessTimes(GetCurrentProcess(), &created, &exited, &kernel, &user)) return 0;
+  const auto ticks = [](const FILETIME& f) {
+    return (static_cast<uint64_t>(f.dwHighDateTime) << 32) | f.dwLowDateTime;  // 100 ns units
+  };
+  return (ticks(kernel) + ticks(user)) * 100;
+}
+
 }  // namespace platform
 }  // namespace ccomm

@@ -123,6 +123,29 @@ def cpu_of(pid):
     return utime + stime, ns, utime, stime
 
 
+def thread_times(pid):
+    """{role: (run ns, times run)} of ccommd `pid`'s threads from schedstat: "main" (the
+    process's own thread), then "send" and "receive" (its next two threads by id: ccommd
+    starts the send thread first), further ones "thread-N"."""
+    out = {}
+    tids = []
+    for p in glob.glob("/proc/%d/task/*" % pid):
+        try:
+            tids.append(int(os.path.basename(p)))
+        except ValueError:
+            pass
+    others = sorted(t for t in tids if t != pid)
+    roles = [(pid, "main")] + [(t, ("send", "receive")[i] if i < 2 else "thread-%d" % i) for i, t in enumerate(others)]
+    for tid, role in roles:
+        try:
+            with open("/proc/%d/task/%d/schedstat" % (pid, tid)) as f:
+                run, _, times = (int(x) for x in f.read().split()[:3])
+        except (OSError, ValueError):
+            continue
+        out[role] = (run, times)
+    return out
+
+
 def link_stats(pid, ifname="eth0"):
     """(tx_packets, tx_bytes) of an interface in the network namespace of process
     `pid`, read from /proc/PID/net/dev: no subprocess, so the reading is taken when
@@ -329,17 +352,21 @@ class DaemonCpuSampler:
     def __init__(self, daemons, names, every=0.02):
         self.daemons, self.names, self.every = daemons, list(names), every
         self.samples = []  # (t_ns, {name: cpu_ns})
+        self.threads = []  # (t_ns, {name: {thread role: (run_ns, times run)}})
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
 
     def _take(self):
-        cpu = {}
+        cpu, threads = {}, {}
         for n in self.names:
             c = self.daemons.cpu(n)
             if c is None:
                 return
             cpu[n] = c[1]
-        self.samples.append((time.monotonic_ns(), cpu))
+            threads[n] = thread_times(self.daemons.pid(n))
+        t = time.monotonic_ns()
+        self.samples.append((t, cpu))
+        self.threads.append((t, threads))
 
     def _run(self):
         while not self._stop.is_set():
@@ -368,6 +395,24 @@ class DaemonCpuSampler:
                 f = (t_ns - t0) / float(t1 - t0) if t1 > t0 else 0.0
                 return c0[name] + f * (c1[name] - c0[name])
         return s[-1][1][name]
+
+    def threads_between(self, t0_ns, t1_ns):
+        """{role: (run ns, times run)} summed over the sampled ccommds between the samples
+        nearest two instants (ccommd's threads: "main" supervises, "send" and "receive"
+        are the I/O threads, in the order ccommd starts them)."""
+        if not self.threads:
+            return {}
+        def nearest(t):
+            return min(self.threads, key=lambda s: abs(s[0] - t))[1]
+        a, b = nearest(t0_ns), nearest(t1_ns)
+        out = {}
+        for n in self.names:
+            for role, (run, times) in b.get(n, {}).items():
+                r0, x0 = a.get(n, {}).get(role, (0, 0))
+                acc = out.setdefault(role, [0, 0])
+                acc[0] += run - r0
+                acc[1] += times - x0
+        return {k: tuple(v) for k, v in out.items()}
 
     def between(self, t0_ns, t1_ns):
         """Every sampled ccommd's CPU ns between two CLOCK_MONOTONIC instants

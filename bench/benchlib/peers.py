@@ -367,13 +367,19 @@ def why(R, check):
                      "(%s in the applications, %s in ccommd)." % (
                          cname, _us(c["cpu_ns_whole_per_value"]), _us(c.get("cpu_apps_ns_whole", 0) / v),
                          _us(c.get("cpu_daemons_ns_whole", 0) / v)))
+        split = ""
+        th = c.get("cpu_daemon_threads") or {}
+        if th:
+            split = " By ccommd thread (both daemons together, per value): %s." % "; ".join(
+                "%s %s µs, run %.2f times" % (role, _us(th[role]["run_ns"] / v), th[role]["times_run"] / v)
+                for role in ("send", "receive", "main") if role in th)
         return ("Per value, `%s` spent %s µs in its two application processes and %s µs in ccommd (both daemons, "
                 "every thread: send and receive threads, the 10 ms supervision tick and heartbeats included), "
                 "each counted over the measured window as the peer's are (the sender's send loop, the receiver "
                 "from its first value to its last; the daemons over the span of both); `%s` spent %s + %s µs in "
                 "its two processes. ccommd's share is the daemon design's price: the peer's library sends from "
-                "the application's own thread.%s" % (
+                "the application's own thread.%s%s" % (
                     cname, _us(c.get("cpu_apps_ns", 0) / v), _us(c.get("cpu_daemons_ns", 0) / v), pname,
                     _us((p.get("cpu_ns") or 0) / float(p.get("values") or 1)),
-                    _us((p.get("cpu_ns_partner") or 0) / float(p.get("values") or 1)), whole))
+                    _us((p.get("cpu_ns_partner") or 0) / float(p.get("values") or 1)), split, whole))
     return ""

@@ -225,7 +225,9 @@ def _window_cpu(res, sampler):
     if daemons is None:
         return None
     apps = sum(int(r["window_cpu_ns"]) for r in sides)
-    return {"cpu_ns": apps + daemons, "cpu_apps_ns": apps, "cpu_daemons_ns": daemons, "window_ns": end - start}
+    return {"cpu_ns": apps + daemons, "cpu_apps_ns": apps, "cpu_daemons_ns": daemons, "window_ns": end - start,
+            "cpu_daemon_threads": {role: {"run_ns": run, "times_run": times}
+                                   for role, (run, times) in sampler.threads_between(start, end).items()}}
 
 
 def _cpu_mark(d, names):

@@ -359,7 +359,12 @@ int main(int argc, char** argv) {
   uint64_t start = Now();
   s.warmup_until = start + static_cast<uint64_t>(o.warmup * 1e9);
   pthread_t rx;
-  pthread_create(&rx, nullptr, Receiver, &s);
+  // Only the threads the mode needs, as an application would have them: a side that only
+  // sends has no receive thread (an idle ccomm_wait would be woken by each of its own
+  // writes), a side that only receives or echoes no periodic loop (next below).
+  const bool receives = !s.recv.empty() || s.ping || s.echo;
+  const bool sends = !s.send.empty() && !s.echo;
+  if (receives) pthread_create(&rx, nullptr, Receiver, &s);
   ccomm::platform::RealtimeRequest fifo;
   fifo.fifo_priority = o.prio;
   if (ccomm::platform::SetUpRealtime(fifo).fifo_priority != 0)
@@ -370,7 +375,8 @@ int main(int argc, char** argv) {
   uint64_t overruns = 0;  // cycles skipped because the loop woke a whole period late or more
   // The sending side's measured window (as a peer's source counts it): the send loop.
   const uint64_t tx_start_ns = Now(), tx_start_cpu_ns = ccomm::platform::ProcessCpuNs();
-  for (uint64_t k = 1;; ++k) {
+  while (!sends && Now() < end) ccomm::platform::SleepUntilNs(static_cast<int64_t>(end));
+  for (uint64_t k = 1; sends; ++k) {
     next += period;
     ccomm::platform::SleepUntilNs(static_cast<int64_t>(next));
     const uint64_t woke = Now();
@@ -392,12 +398,11 @@ int main(int argc, char** argv) {
   // Let the last frames arrive.
   ccomm::platform::SleepNsInterruptible(200 * 1000 * 1000);
   s.stop = true;
-  pthread_join(rx, nullptr);
+  if (receives) pthread_join(rx, nullptr);
   // This process's CPU over its measured window, every thread (docs/performance.md, "CPU
   // per value"): the send loop where it sends, else from its first value received to its
   // last (its CPU to the end: the idle wait after the last value is in it); start-up,
   // attach and memory locking are outside it, as they are for the peers.
-  const bool sends = !s.send.empty() && !s.echo;
   uint64_t win_start = 0, win_end = 0, win_cpu = 0, win_values = 0;
   if (sends) {
     win_start = tx_start_ns, win_end = tx_end_ns, win_cpu = tx_end_cpu_ns - tx_start_cpu_ns;

@@ -94,7 +94,9 @@ def bin_path(args, name):
 
 
 # ---- floor ---------------------------------------------------------------------------------
-def floor(args):
+def floor(args, final=True):
+    """The floor once; with final=False a loss is not judged but said, and the result says
+    retry (main measures again: the floor is the topology's reference, not ccomm)."""
     n = args.boards
     r = Run(args, n)
     prog = bin_path(args, "manyboards_floor")
@@ -130,6 +132,11 @@ def floor(args):
         what = "floor: every frame received by every board that wants it (lost %d)" % lost
         # The floor is plain sockets without ccomm: what it loses on a saturated host (a
         # receiver not scheduled while its socket buffer filled) is the host's, as below.
+        if not (exact and lost == 0) and not final:
+            print("# %s, CPU pressure %s, late cycles %d: measured again" % (
+                what, "%.0f%%" % (100 * pressure) if pressure is not None else "unknown",
+                sum(res[j]["late_cycles"] for j in res)), flush=True)
+            return r, {"retry": True}
         if not (exact and lost == 0) and pressure is not None and pressure > 0.30:
             r.todo("%s [CPU pressure %.0f%% over the run: host saturated]" % (what, 100 * pressure))
         else:
@@ -509,7 +516,16 @@ def main():
         return 4
     topology.sweep_stale()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
-    r, summary = floor(args) if args.mode == "floor" else system(args)
+    if args.mode == "floor":
+        # A floor that lost frames is measured again, up to three times in all (CI: 826
+        # frames lost by bare sockets at 25 % CPU pressure beside the image build, while
+        # ccomm then lost none): its last try is judged.
+        for attempt in (1, 2, 3):
+            r, summary = floor(args, final=attempt == 3)
+            if not summary.get("retry"):
+                break
+    else:
+        r, summary = system(args)
     summary["checks"] = r.checks
     summary["work"] = r.work
     print(json.dumps(summary))

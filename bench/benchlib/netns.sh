@@ -27,6 +27,7 @@ IP_A=198.18.76.1
 IP_B=198.18.76.2
 MAC_A=02:cc:b0:00:00:01
 MAC_B=02:cc:b0:00:00:02
+PAIR=$(cd "$(dirname "$0")/../.." && pwd)/scripts/netns-pair
 
 need_root() {
     if [ "$(id -u)" -ne 0 ]; then
@@ -36,54 +37,18 @@ need_root() {
     command -v ip >/dev/null 2>&1 || { echo "netns.sh: iproute2 'ip' not found; skipping" >&2; exit 4; }
 }
 
-exists() { ip netns list 2>/dev/null | awk '{print $1}' | grep -qx "$1"; }
 
-down() {
-    for ns in "$NS_A" "$NS_B"; do
-        if exists "$ns"; then
-            # Anything still running inside would keep the namespace alive: end it.
-            for pid in $(ip netns pids "$ns" 2>/dev/null); do kill "$pid" 2>/dev/null || true; done
-            ip netns del "$ns" 2>/dev/null || true
-        fi
-    done
-}
+down() { "$PAIR" down "$NS_A" "$NS_B"; }
 
 up() {
-    for ns in "$NS_A" "$NS_B"; do
-        if exists "$ns"; then
-            echo "netns.sh: namespace $ns already exists (another run, or a stale one: 'netns.sh down')" >&2
-            exit 1
-        fi
-    done
-    if ! ip netns add "$NS_A" 2>/dev/null; then
-        echo "netns.sh: cannot create network namespaces here (no CAP_SYS_ADMIN?); skipping" >&2
-        exit 4
-    fi
-    CREATED=1
-    ip netns add "$NS_B"
-    # Create the pair directly inside the namespaces: no name is ever taken in the
-    # host namespace, so parallel runs with other prefixes cannot collide.
-    ip link add eth0 netns "$NS_A" address "$MAC_A" type veth peer name eth0 netns "$NS_B" address "$MAC_B"
-    for side in a b; do
-        if [ $side = a ]; then ns=$NS_A addr=$IP_A; else ns=$NS_B addr=$IP_B; fi
-        ip netns exec "$ns" sysctl -qw net.ipv6.conf.all.disable_ipv6=1 net.ipv6.conf.default.disable_ipv6=1 \
-            >/dev/null 2>&1 || true
-        ip -n "$ns" link set lo up
-        ip -n "$ns" addr add "$addr/24" dev eth0
-        ip -n "$ns" link set eth0 up
-        ip -n "$ns" route add 224.0.0.0/4 dev eth0
-    done
-    # Wait for the carrier (both ends up) so the first frames are not dropped.
-    i=0
-    while [ $i -lt 50 ]; do
-        if ip -n "$NS_A" link show eth0 | grep -q 'state UP' && ip -n "$NS_B" link show eth0 | grep -q 'state UP'; then
-            return 0
-        fi
-        i=$((i + 1))
-        sleep 0.1
-    done
-    echo "netns.sh: veth did not come up" >&2
-    return 1
+    # The one two-board network of tests, bench and demo (scripts/netns-pair), with the
+    # bench's addresses and multicast routed over eth0 (LCM's udpm).
+    rc=0
+    "$PAIR" up "$NS_A" "$NS_B" --ip-a "$IP_A/24" --ip-b "$IP_B/24" --mac-a "$MAC_A" --mac-b "$MAC_B" \
+        --multicast || rc=$?
+    [ $rc -eq 0 ] && CREATED=1
+    [ $rc -eq 4 ] && exit 4
+    return $rc
 }
 
 floor() {

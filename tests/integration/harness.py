@@ -11,6 +11,7 @@ import time
 import uuid
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+NETNS_PAIR = os.path.join(ROOT, "scripts", "netns-pair")
 BUILD = os.environ.get("CCOMM_BUILD_DIR", os.path.join(ROOT, "build", "release"))  # docs/testing.md
 BIN = os.path.join(BUILD, "bin")
 DEFAULT_CONFIG = os.path.join(ROOT, "dist", "signals.xml")
@@ -96,13 +97,8 @@ class NodePair:
     def __enter__(self):
         c, p = self.ns["control"], self.ns["planner"]
         try:
-            run(["ip", "netns", "add", c])
-            run(["ip", "netns", "add", p])
-            run(["ip", "link", "add", "eth0", "netns", c, "type", "veth", "peer", "name", "eth0", "netns", p])
-            for ns, ip in ((c, "10.42.0.1/24"), (p, "10.42.0.2/24")):
-                run(["ip", "-n", ns, "addr", "add", ip, "dev", "eth0"])
-                run(["ip", "-n", ns, "link", "set", "eth0", "up"])
-                run(["ip", "-n", ns, "link", "set", "lo", "up"])
+            # The one two-board network of tests, bench and demo.
+            run([NETNS_PAIR, "up", c, p, "--ip-a", "10.42.0.1/24", "--ip-b", "10.42.0.2/24"])
         except BaseException:
             self.__exit__(None, None, None)  # a half-made pair leaves nothing behind
             raise
@@ -115,8 +111,7 @@ class NodePair:
                 proc.wait()
         for node in list(self.daemons):
             self.stop(node)
-        for ns in self.ns.values():
-            run(["ip", "netns", "del", ns], check=False)
+        run([NETNS_PAIR, "down", *self.ns.values()], check=False)
         for node in self.ns:
             for suffix in ("", ".view", ".lock"):  # the segment, the system view, the node lock
                 path = "/dev/shm/" + self.env["CCOMM_SHM_PREFIX"].lstrip("/") + node + suffix

@@ -127,11 +127,10 @@ ns_up_eth0() {  # ns_up_eth0 NS IP
 # control (NS_C, 10.42.0.1) and planner (NS_P, 10.42.0.2) joined by one veth pair.
 make_pair() {
   NS_C=$TAG-c NS_P=$TAG-p
-  ns_new "$NS_C"
-  ns_new "$NS_P"
-  ip link add eth0 netns "$NS_C" type veth peer name eth0 netns "$NS_P"
-  ns_up_eth0 "$NS_C" 10.42.0.1
-  ns_up_eth0 "$NS_P" 10.42.0.2
+  # The one two-board network of tests, bench and demo; removed with the others at exit.
+  "$ROOT/scripts/netns-pair" up "$NS_C" "$NS_P" --ip-a 10.42.0.1/24 --ip-b 10.42.0.2/24 ||
+    { echo "Bail out! scripts/netns-pair up $NS_C $NS_P"; exit 1; }
+  NAMESPACES+=("$NS_C" "$NS_P")
   static_neighbours
 }
 # Same, with a middle namespace NS_M bridging them through $WORK/impair (m0 <-> m1).

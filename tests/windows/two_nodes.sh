@@ -106,11 +106,8 @@ fi
 
 # ---- b. two nodes ----------------------------------------------------------------------
 ns_l=ccomm-w$$-linux ns_w=ccomm-w$$-wine
-ip netns add "$ns_l" && ip netns add "$ns_w" &&
-  ip link add eth0 netns "$ns_l" type veth peer name eth0 netns "$ns_w" &&
-  ip -n "$ns_l" addr add 10.42.0.1/24 dev eth0 && ip -n "$ns_w" addr add 10.42.0.2/24 dev eth0 &&
-  for ns in "$ns_l" "$ns_w"; do ip -n "$ns" link set eth0 up && ip -n "$ns" link set lo up; done ||
-  { check "network namespaces joined by a veth pair" false; return 0; }
+"$SRC/scripts/netns-pair" up "$ns_l" "$ns_w" --ip-a 10.42.0.1/24 --ip-b 10.42.0.2/24 ||
+  { check "network namespaces joined by a veth pair (scripts/netns-pair)" false; return 0; }
 # Arrays, not functions: a command started in the background through them has $! = its pid.
 in_l=(ip netns exec "$ns_l")
 # Wine's sockets are made by its wineserver: it must live in the Windows namespace, so

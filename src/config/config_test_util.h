@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "config/config.h"
+#include "testing/config_document.h"
 
 #ifndef CCOMM_SOURCE_DIR
 #error "CCOMM_SOURCE_DIR must point at the source tree (set by src/config/CMakeLists.txt)"
@@ -38,13 +39,9 @@ inline std::string MustFail(const std::string& xml) {
   return err;
 }
 
-// Two raw nodes a, b and the given extra lines inside <ccomm>.
-inline std::string TwoNodes(const std::string& body) {
-  return "<ccomm version=\"1\">\n"
-         "  <node name=\"a\" interface=\"eth0\"/>\n"
-         "  <node name=\"b\" interface=\"eth0\"/>\n" +
-         body + "\n</ccomm>\n";
-}
+// Two raw nodes a, b (lines 2-3) and the given extra lines inside <ccomm> from line 4
+// (testing/config_document.h: the tests' one two-node document).
+inline std::string TwoNodes(const std::string& body) { return testing::TwoNodeXml(body); }
 
 // The *.xml files directly in `dir`, sorted.
 inline std::vector<std::string> XmlFilesIn(const std::string& dir) {

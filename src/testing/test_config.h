@@ -25,7 +25,9 @@ inline SignalConfig MakeSignal(const std::string& name, ValueType type, uint32_t
   return s;
 }
 
-/// Two nodes "a" (0) and "b" (1); signals chosen by the test.
+/// Two nodes "a" (0) and "b" (1) on loopback; signals chosen by the test. The model
+/// itself, built without XML: the store's and client's tests sit below the parser (the
+/// tests' two-node document in text is testing/config_document.h's TwoNodeXml).
 inline SystemConfig TwoNodeConfig(std::vector<SignalConfig> signals) {
   SystemConfig cfg;
   cfg.path = "test.xml";

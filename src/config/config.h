@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "common/value_type.h"
-#include "config/outline.h"
+#include "config/public/outline.h"
 
 namespace ccomm {
 

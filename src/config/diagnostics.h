@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "config/outline.h"
+#include "config/public/outline.h"
 
 namespace ccomm {
 namespace config_detail {

@@ -7,7 +7,7 @@
 
 #include "config/config.h"
 #include "config/config_json.h"
-#include "config/outline.h"
+#include "config/public/outline.h"
 #include "testing/config_document.h"
 
 namespace ccomm {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The configuration as the owner of an extension section reads it (outline.h).
-#include "config/outline.h"
+#include "config/public/outline.h"
 
 #include <utility>
 

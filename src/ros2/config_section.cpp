@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // The <ros2> element of signals.xml for the bridge's node: the file read with the parser
-// `ccommd --check` runs (config/outline.h), the <ros2> sections checked here (section.h),
+// `ccommd --check` runs (config/public/outline.h), the <ros2> sections checked here (section.h),
 // their settings applied under whatever the command line set explicitly.
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "bridge.h"
-#include "config/outline.h"
+#include "config/public/outline.h"
 #include "section.h"
 
 namespace ccomm_ros2 {

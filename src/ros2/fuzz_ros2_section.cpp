@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "config/outline.h"
+#include "config/public/outline.h"
 #include "section.h"
 
 namespace {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The <ros2> sections of signals.xml, read and checked by the bridge that owns them: the
-// core parser keeps them as element trees (config/outline.h) and checks their structure
+// core parser keeps them as element trees (config/public/outline.h) and checks their structure
 // only. No DDS here: `ccomm-ros2 --check` and the unit test need none.
 //   <ros2 node="planner" namespace="robot1" domain="7"
 //         publish="pos, joints" subscribe="setpoint, cmd"/>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "config/outline.h"
+#include "config/public/outline.h"
 
 namespace ccomm_ros2 {
 

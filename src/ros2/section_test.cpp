@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "config/outline.h"
+#include "config/public/outline.h"
 #include "ros2/section.h"
 #include "testing/config_document.h"
 

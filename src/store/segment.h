@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 #include "store/event_ring.h"
 #include "store/layout.h"
 #include "store/state_slot.h"
@@ -17,7 +17,7 @@ namespace ccomm {
 namespace store {
 
 /// POSIX shm name of a node's segment: $CCOMM_SHM_PREFIX (default "/ccomm.") + node,
-/// built by the platform layer (common/platform_app.h) for every user of the name.
+/// built by the platform layer (common/public/platform_app.h) for every user of the name.
 using platform::SegmentName;
 
 class Segment {

@@ -12,13 +12,17 @@
   the C API (ccomm_*), and needs no library beyond the C/C++ runtime;
 - the applications of the public API (the CLI, tools, the FMU runner, the ROS 2 bridge)
   include nothing of config, daemon, store, wire, client or common: ccomm.h/ccomm.hpp
-  only, the platform layer's part for programs (common/platform_app.h: real-time set-up,
+  only, the platform layer's part for programs (common/public/platform_app.h: real-time set-up,
   sleeps, the exclusive lock, segment names), and a program that owns an extension
   section of signals.xml (the bridge's <ros2>) the configuration's public interface
-  config/outline.h; a public interface itself includes standard headers only;
+  config/public/outline.h: public interfaces are marked by place (a module's public/
+  folder), every other header of the core is private; a public interface itself includes
+  standard headers only;
 - OS calls the platform layer wraps (shared memory, memory locking, scheduling, CPU
-  affinity, sleeping) are made only in its units, src/common/platform/: nowhere else
-  under src/, tests included (FORBIDDEN_CALLS);
+  affinity, sleeping) are made only in its units, src/common/platform/: nowhere else in
+  the tree, tests, tools, integrations, bench and Python included (FORBIDDEN_CALLS;
+  applications use ccomm.h's ccomm_realtime_setup and ccomm_sleep_until), but for the
+  programs of OS_CALL_EXCEPTIONS;
 - ccommd (src/daemon/) is rooms (ROOMS): each a folder with a README.md that says what it
   owns, no source file outside them; a room's units include only the rooms it may use
   (its tests aside); a room's platform code is in its posix/ and windows/ folders, and its
@@ -43,22 +47,55 @@ APPLICATIONS = ("cli", "tools", "fmu", "ros2")
 INTERNALS = {"config", "daemon", "store", "wire", "client", "common"}
 # (file, include): why it is allowed for now (none: keep it that way).
 APPLICATION_INCLUDES = {}
-# Public interfaces of internal modules, and who may include them.
-PUBLIC_INTERFACES = {
-    "config/outline.h": "the configuration as the owner of an extension section reads it (src/ros2: <ros2>)",
-    "common/platform_app.h": "the platform layer's part for programs: real-time set-up, sleeps, the exclusive "
-                             "lock, segment names (one implementation for ccommd, the library and the programs)",
-}
+# Public interfaces of internal modules are marked by place: a module's public/ folder
+# (src/config/public/outline.h: the configuration as the owner of an extension section
+# reads it; src/common/public/platform_app.h: the platform layer's part for programs).
+# Every other header of an internal module is private to the core. No list to keep.
+PUBLIC_FOLDER = "public"
+
+
+def is_public_interface(include):
+    parts = include.split("/")
+    return len(parts) == 3 and parts[0] in INTERNALS and parts[1] == PUBLIC_FOLDER and parts[2].endswith(".h")
+
+
+def public_interface_headers(src):
+    return sorted("%s/%s/%s" % (m, PUBLIC_FOLDER, f) for m in sorted(INTERNALS)
+                  if os.path.isdir(os.path.join(src, "src", m, PUBLIC_FOLDER))
+                  for f in os.listdir(os.path.join(src, "src", m, PUBLIC_FOLDER)) if f.endswith(".h"))
+
+
 # OS calls only the platform layer's units (src/common/platform/) make: the POSIX calls
 # and their Windows counterparts. Anywhere else under src/ a call of one fails the test
-# (comments and string literals aside); use common/platform.h or common/platform_app.h.
+# (comments and string literals aside); use common/platform.h or common/public/platform_app.h.
 PLATFORM_DIR = "src/common/platform/"
 FORBIDDEN_CALLS = ("shm_open", "shm_unlink", "mlockall", "munlockall", "sched_setscheduler", "sched_setaffinity",
                    "pthread_setschedparam", "pthread_setaffinity_np", "nanosleep", "clock_nanosleep", "flock",
                    "SetThreadPriority", "SetThreadAffinityMask", "SetProcessWorkingSetSize", "CreateFileMapping", "CreateFileMappingA",
                    "CreateFileMappingW", "OpenFileMapping", "OpenFileMappingA", "OpenFileMappingW")
 FORBIDDEN_CALL = re.compile(r"(?<![\w.>:])(?:::)?(%s)\s*\(" % "|".join(FORBIDDEN_CALLS))
+# Programs outside src/ that make such calls themselves, and why they may.
+OS_CALL_EXCEPTIONS = {
+    "bench/bench_common.h": "the bench's platform layer for its floor and peer programs, which link nothing "
+                            "of ccomm (a floor measures the OS alone, a peer runs as its own users run it)",
+    "bench/peers/common/src/lib.rs": "the Rust peers' counterpart of bench/bench_common.h",
+    "bench/txtime/txtime_spread.c": "a probe of the kernel's SO_TXTIME, nothing of ccomm in it: it sleeps on "
+                                    "CLOCK_REALTIME, which ccomm's API has no call for",
+    "tests/fmu/bare_loop.c": "the floor of ccomm-fmu's jitter: the same periodic loop with nothing of ccomm",
+    "tests/reliability/garbage.c": "writes over a node's segment as a buggy client would, past libccomm: it "
+                                   "maps the segment itself",
+    "tests/reliability/flood.c": "forges frames at a socket as an attacker would; links nothing of ccomm",
+    "tests/ros2/bench/latency_probe.c": "Cyclone DDS alone, the bridge's peer figure; links nothing of ccomm",
+    "tests/syscalls/syscount.c": "its pauses must be relative: under board_clock.so the clock ccomm_now() "
+                                 "reads is shifted, so an absolute deadline on it would be wrong",
+}
 C_CODE = (".c", ".cc", ".cpp", ".h", ".hpp")
+# Python: comments and string literals are not code; a call is a name followed by "(",
+# also as an attribute (os.sched_setscheduler, ctypes.CDLL(None).mlockall). flock is
+# left out: a Python tool's lock of its own file (qemu-tests/lib/vmctl.py) is no node lock.
+PY_NOT_CODE = re.compile(r'"""(?:.|\n)*?"""|\'\'\'(?:.|\n)*?\'\'\'|#[^\n]*|"(?:\\.|[^"\\\n])*"|'
+                         r"'(?:\\.|[^'\\\n])*'")
+PY_FORBIDDEN_CALL = re.compile(r"(?<!\w)(%s)\s*\(" % "|".join(c for c in FORBIDDEN_CALLS if c != "flock"))
 # Comments, string and character literals (raw strings first): what is not code.
 NOT_CODE = re.compile(r'R"([^(\s]*)\((?:.|\n)*?\)\1"|//[^\n]*|/\*(?:.|\n)*?\*/|"(?:\\.|[^"\\\n])*"|'
                       r"'(?:\\.|[^'\\\n])*'")
@@ -116,7 +153,7 @@ def library(build, module, name):
     return path
 
 
-def tracked_code(src):
+def tracked_code(src, extra=()):
     """Source files of the tree (git's list when it is a checkout), relative to `src`."""
     r = subprocess.run(["git", "-C", src, "ls-files"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     if r.returncode == 0 and r.stdout:
@@ -124,7 +161,7 @@ def tracked_code(src):
     else:
         names = [os.path.relpath(os.path.join(d, f), src) for d, _, fs in os.walk(src) for f in fs
                  if "/build" not in d and "/." not in d]
-    return sorted(n for n in names if n.endswith(CODE) and os.path.isfile(os.path.join(src, n)))
+    return sorted(n for n in names if n.endswith(CODE + tuple(extra)) and os.path.isfile(os.path.join(src, n)))
 
 
 def one_parser_one_table(src, errors):
@@ -155,7 +192,7 @@ def application_includes(src, errors):
             text = open(os.path.join(adir, fname), encoding="utf-8").read()
             for inc in INCLUDE.findall(text):
                 if inc.split("/")[0] in INTERNALS and "/" in inc and (rel, inc) not in APPLICATION_INCLUDES \
-                        and inc not in PUBLIC_INTERFACES:
+                        and not is_public_interface(inc):
                     errors.append('%s includes "%s": applications use the public API (ccomm/ccomm.h) only'
                                   % (rel, inc))
 
@@ -188,15 +225,24 @@ def unique_file_names(src, errors):
 
 
 def os_calls_in_platform_layer(src, errors):
-    """The calls of FORBIDDEN_CALLS only in src/common/platform/."""
-    for name in tracked_code(src):
-        if not name.startswith("src/") or name.startswith(PLATFORM_DIR) or not name.endswith(C_CODE):
+    """The calls of FORBIDDEN_CALLS only in src/common/platform/, in the whole tree (C, C++,
+    Rust and Python: os.sched_setscheduler and a ctypes mlockall count too), but for the
+    programs of OS_CALL_EXCEPTIONS."""
+    for name in tracked_code(src, extra=(".rs",)):
+        if name.startswith(PLATFORM_DIR) or name in OS_CALL_EXCEPTIONS:
+            continue
+        if name.endswith(C_CODE + (".rs",)):
+            not_code, call = NOT_CODE, FORBIDDEN_CALL
+        elif name.endswith(".py"):
+            not_code, call = PY_NOT_CODE, PY_FORBIDDEN_CALL
+        else:
             continue
         text = open(os.path.join(src, name), encoding="utf-8", errors="replace").read()
-        code = NOT_CODE.sub(lambda m: "\n" * m.group(0).count("\n"), text)  # keeps line numbers
-        for m in FORBIDDEN_CALL.finditer(code):
-            errors.append("%s:%d calls %s(): an OS call the platform layer wraps (common/platform.h, "
-                          "common/platform_app.h; its units are in %s)"
+        code = not_code.sub(lambda m: "\n" * m.group(0).count("\n"), text)  # keeps line numbers
+        for m in call.finditer(code):
+            errors.append("%s:%d calls %s(): an OS call the platform layer wraps (in the core common/platform.h "
+                          "and common/public/platform_app.h, units in %s; for an application ccomm.h's "
+                          "ccomm_realtime_setup and ccomm_sleep_until, in Python ccomm.realtime_setup)"
                           % (name, code.count("\n", 0, m.start()) + 1, m.group(1), PLATFORM_DIR))
 
 
@@ -267,7 +313,10 @@ def daemon_rooms(src, errors):
 
 def public_interfaces(src, errors):
     """A public interface is public only if it pulls in no internals."""
-    for header in PUBLIC_INTERFACES:
+    headers = public_interface_headers(src)
+    if not headers:
+        errors.append("no src/MODULE/%s/ header found: the public interfaces moved?" % PUBLIC_FOLDER)
+    for header in headers:
         text = open(os.path.join(src, "src", header), encoding="utf-8").read()
         for inc in INCLUDE.findall(text):
             errors.append('src/%s includes "%s": a public interface includes standard headers only'
@@ -336,7 +385,7 @@ def main():
         print("layering: " + e)
     if not errors:
         print("layering: store and wire are bottom modules; libccomm.so carries no configuration parser; "
-              "applications use the public API (and config/outline.h, common/platform_app.h); OS calls of the "
+              "applications use the public API (and config/public/outline.h, common/public/platform_app.h); OS calls of the "
               "platform layer only in its units; ccommd's rooms as ROOMS allows; one file per name; one parser of signals.xml, one table of type names")
     return 1 if errors else 0
 

@@ -2,7 +2,16 @@
 /*
  * Shared helpers of the floor and peer latency programs: monotonic timestamps,
  * a preallocated sample buffer, summary statistics, the one-line JSON result,
- * raw sample dumps and the real-time set-up (CPU pinning, SCHED_FIFO, mlockall).
+ * raw sample dumps, the real-time set-up (CPU pinning, SCHED_FIFO, mlockall) and a
+ * shared-memory object.
+ *
+ * The bench's own platform layer: the one place its C programs make the OS calls that
+ * ccomm's code makes only in src/common/platform/ (shm_open, mlockall,
+ * sched_setscheduler, clock_nanosleep). A floor or peer program links nothing of ccomm
+ * (a floor measures the OS alone, a peer runs as its own users run it); the programs
+ * that do link libccomm (ccomm_pingpong's ccomm side, manyboards_app) set up through
+ * ccomm_realtime_setup like any application. The Rust peers' counterpart is
+ * peers/common/src/lib.rs.
  *
  * Header-only and libc-only on purpose: net_floor is cross-compiled for 32-bit ARM
  * with nothing but `cc -O2 net_floor.c` and this header beside it.
@@ -15,6 +24,7 @@
 #endif
 
 #include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
 #include <inttypes.h>
 #include <limits.h>
@@ -472,6 +482,28 @@ static inline bench_rt bench_rt_setup(int cpu, int prio, int want_mlock)
             fprintf(stderr, "note: mlockall not permitted (%s); running unlocked\n", strerror(errno));
     }
     return r;
+}
+
+/* Maps the shared-memory object `name` (created zeroed if missing) of `size` bytes, read
+ * and write; ends the program on failure. Both sides of an exchange may call it first. */
+static inline void *bench_shm_map(const char *name, size_t size)
+{
+    int fd = shm_open(name, O_RDWR | O_CREAT, 0600);
+    if (fd < 0)
+        bench_die("shm_open %s: %s", name, strerror(errno));
+    if (ftruncate(fd, (off_t)size) != 0)
+        bench_die("ftruncate %s: %s", name, strerror(errno));
+    void *p = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    close(fd);
+    if (p == MAP_FAILED)
+        bench_die("mmap %s: %s", name, strerror(errno));
+    return p;
+}
+
+/* Removes the shared-memory object `name` (its mappings stay valid). */
+static inline void bench_shm_remove(const char *name)
+{
+    shm_unlink(name);
 }
 
 /* Number of CPUs this process may run on (for the two-core sanity checks). */

@@ -145,16 +145,7 @@ static int64_t floor_exchange(struct floor_line *f, uint32_t req, const unsigned
  * run (it must start zeroed); the ping side removes it at the end. */
 static struct floor_line *floor_map(const char *name)
 {
-    int fd = shm_open(name, O_RDWR | O_CREAT, 0600);
-    if (fd < 0)
-        bench_die("shm_open %s: %s", name, strerror(errno));
-    if (ftruncate(fd, sizeof(struct floor_line)) != 0)
-        bench_die("ftruncate %s: %s", name, strerror(errno));
-    void *p = mmap(NULL, sizeof(struct floor_line), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-    close(fd);
-    if (p == MAP_FAILED)
-        bench_die("mmap %s: %s", name, strerror(errno));
-    return (struct floor_line *)p;
+    return (struct floor_line *)bench_shm_map(name, sizeof(struct floor_line));
 }
 
 static ccomm_signal find(ccomm_client *c, const char *name, ccomm_signal_desc *d)
@@ -473,6 +464,6 @@ int main(int argc, char **argv)
     bench_print_result(o.name, "shm", &o, o.half ? "rtt_half" : "rtt", &st, &rt, extra);
     ccomm_close(s->c);
     if (run.floor && role == R_PING && floor_name)
-        shm_unlink(floor_name);
+        bench_shm_remove(floor_name);
     return (!received || bench_stop_flag) ? BENCH_EXIT_FAIL : BENCH_EXIT_OK;
 }

@@ -195,8 +195,7 @@ int main(int argc, char **argv)
                     ready = 1;
                 }
             } else {
-                struct timespec ts = {0, 10000000};
-                nanosleep(&ts, NULL);
+                bench_sleep_until(bench_now_ns() + 10000000);
             }
         }
         if (!ready) {
@@ -251,8 +250,7 @@ int main(int argc, char **argv)
                  n.wait == W_SPIN ? "spin" : "waitset", sent, foreign, alloc_fail);
         bench_print_result(o.name, "iceoryx", &o, o.half ? "rtt_half" : "rtt", &st, &rt, extra);
         /* Give the echo a moment to take the FIN before our ports go away. */
-        struct timespec ts = {0, 20000000};
-        nanosleep(&ts, NULL);
+        bench_sleep_until(bench_now_ns() + 20000000);
         if (!received) {
             iox_runtime_shutdown();
             return BENCH_EXIT_FAIL;

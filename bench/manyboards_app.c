@@ -20,13 +20,11 @@
 
 #include <errno.h>
 #include <pthread.h>
-#include <sched.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/resource.h>
 #include <time.h>
 
@@ -59,10 +57,9 @@ static int cmp_i64(const void* a, const void* b) {
 }
 
 static void set_fifo(int prio) {
-  if (prio <= 0) return;
-  struct sched_param sp = {.sched_priority = prio};
-  int r = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-  if (r) fprintf(stderr, "manyboards_app: SCHED_FIFO %d: %s (continuing)\n", prio, strerror(r));
+  int32_t err[3];
+  if (prio > 0 && ccomm_realtime_setup(-1, 0, prio, err) != 0)
+    fprintf(stderr, "manyboards_app: SCHED_FIFO %d: %s (continuing)\n", prio, strerror(-err[2]));
 }
 
 typedef struct {
@@ -102,8 +99,7 @@ static void usage(void) {
 }
 
 static void sleep_until(int64_t t) {
-  struct timespec ts = {(time_t)(t / 1000000000), (long)(t % 1000000000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+  while (ccomm_sleep_until(t) == 1) {
   }
 }
 
@@ -126,7 +122,9 @@ int main(int argc, char** argv) {
     else usage();
   }
   if (!node || rate <= 0 || seconds <= 0) usage();
-  if (prio > 0 && mlockall(MCL_CURRENT | MCL_FUTURE) != 0) perror("manyboards_app: mlockall (continuing)");
+  int32_t err[3];
+  if (prio > 0 && ccomm_realtime_setup(-1, 1, 0, err) != 0)
+    fprintf(stderr, "manyboards_app: memory lock: %s (continuing)\n", strerror(-err[1]));
 
   ccomm_client* c;
   int r = ccomm_open(node, CCOMM_OPEN_BATCH, &c);

@@ -27,7 +27,7 @@ ccomm_core_target(ccomm_segment_builder)
 target_link_libraries(ccomm_segment_builder PUBLIC ccomm_store ccomm_config)
 
 set(_cl ${CMAKE_CURRENT_LIST_DIR}/client)
-add_library(ccomm SHARED ${_cl}/client.cpp ${_cl}/client_open.cpp ${_cl}/client_info.cpp ${_cl}/history.cpp
+add_library(ccomm SHARED ${_cl}/client.cpp ${_cl}/client_open.cpp ${_cl}/client_info.cpp ${_cl}/client_realtime.cpp ${_cl}/history.cpp
             ${_cl}/system_view_reader.cpp ${_cl}/doorbell_futex.cpp)
 ccomm_core_target(ccomm)
 target_compile_definitions(ccomm PRIVATE CCOMM_BUILDING_DLL)

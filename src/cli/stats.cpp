@@ -14,7 +14,7 @@
 
 #include "ccomm/ccomm.h"
 #include "cli/values.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace {
 

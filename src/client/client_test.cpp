@@ -4,6 +4,7 @@
 #include "ccomm/ccomm.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +59,35 @@ class ClientTest : public ::testing::Test {
   SystemConfig cfg_;
   store::Segment seg_a_, seg_b_;
 };
+
+// The application's real-time set-up and periodic sleep: the platform layer's, through
+// the C API (no handle needed); a part that cannot be done is said per part.
+TEST(ClientRealtime, SetUpSaysEachPartAndSleepUntilKeepsItsDeadline) {
+  int32_t err[3] = {7, 7, 7};
+  EXPECT_EQ(ccomm_realtime_setup(-1, 0, 0, err), 0);  // nothing asked: nothing fails
+  EXPECT_EQ(err[0], 0);
+  EXPECT_EQ(err[1], 0);
+  EXPECT_EQ(err[2], 0);
+  EXPECT_EQ(ccomm_realtime_setup(-1, 0, 0, nullptr), 0);
+  // A CPU this machine does not have: that part fails, the others are untouched.
+  EXPECT_EQ(ccomm_realtime_setup(1000, 0, 0, err), CCOMM_E_SYS);
+  EXPECT_LT(err[0], 0);
+  EXPECT_EQ(err[1], 0);
+  EXPECT_EQ(err[2], 0);
+  // The CPU this thread runs on: pinning to it is allowed without privilege.
+  const int cpu = sched_getcpu();
+  ASSERT_GE(cpu, 0);
+  EXPECT_EQ(ccomm_realtime_setup(cpu, 0, 0, err), 0);
+  EXPECT_EQ(err[0], 0);
+
+  EXPECT_EQ(ccomm_sleep_until(-1), CCOMM_E_INVAL);
+  const int64_t t0 = ccomm_now();
+  EXPECT_EQ(ccomm_sleep_until(t0 - 1000000), 0);  // past: at once
+  const int64_t deadline = ccomm_now() + 20000000;
+  EXPECT_EQ(ccomm_sleep_until(deadline), 0);
+  EXPECT_GE(ccomm_now(), deadline);
+  EXPECT_EQ(ccomm::Client::sleep_until(ccomm_now() + 1000000), 0);
+}
 
 TEST_F(ClientTest, OpenFindDescribe) {
   ccomm_client* c = nullptr;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The platform layer (zenoh-pico style): every OS call of the store, the client library
 // and ccommd's threads (clock, futex, shared memory, scheduling, sleeping, logging) goes
-// through this header and common/platform_app.h, its part the programs of the public API
+// through this header and common/public/platform_app.h, its part the programs of the public API
 // use too (real-time set-up, sleeping, the exclusive lock, segment names). It has one set
 // of units per platform, whole files chosen by CMake (src/common/CMakeLists.txt), never
 // #ifdefs inside functions:
@@ -19,7 +19,7 @@
 #include <atomic>
 #include <string>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 #if defined(_MSC_VER)
 #include <intrin.h>  // _mm_pause
 #endif

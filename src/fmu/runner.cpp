@@ -18,7 +18,7 @@
 #include <map>
 #include <new>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 extern char** environ;
 

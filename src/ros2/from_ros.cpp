@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "bridge.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 #include "sample_layout.h"
 
 namespace ccomm_ros2 {

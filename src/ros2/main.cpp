@@ -14,7 +14,7 @@
 
 #include "bridge.h"
 #include "section.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace ccomm_ros2 {
 

@@ -13,7 +13,7 @@
 #include <cstdio>
 
 #include "bridge.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 #include "sample_layout.h"
 
 namespace ccomm_ros2 {

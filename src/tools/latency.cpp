@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "ccomm/ccomm.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 #include "tools/json_text.h"
 
 namespace {

@@ -34,8 +34,7 @@ static uint64_t now_ns(void) {
 }
 
 static void sleep_until(uint64_t t) {
-  struct timespec ts = {(time_t)(t / 1000000000ull), (long)(t % 1000000000ull)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0 && !g_stop) {
+  while (ccomm_sleep_until((int64_t)t) != 0 && !g_stop) {
   }
 }
 

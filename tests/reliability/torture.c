@@ -111,8 +111,7 @@ static int cmd_write(struct conn* k, double rate) {
       next += period;
       uint64_t t = now_ns();
       if (next > t) {
-        struct timespec ts = {(time_t)((next - t) / 1000000000ull), (long)((next - t) % 1000000000ull)};
-        nanosleep(&ts, NULL);
+        ccomm_sleep_until((int64_t)next);
       } else if (t - next > 100 * period) {
         next = t;  /* fell far behind (stopped, descheduled): do not burst */
       }
@@ -234,8 +233,7 @@ static int cmd_stale(const char* node, const char* name, double timeout) {
       ccomm_close(c);
       return 0;
     }
-    struct timespec ts = {0, 100000}; /* 0.1 ms: the resolution of the figure */
-    nanosleep(&ts, NULL);
+    ccomm_sleep_until(ccomm_now() + 100000); /* 0.1 ms: the resolution of the figure */
   }
   printf("{\"stale\":\"%s\",\"timeout\":true,\"fresh_reads\":%" PRIu64 "}\n", name, fresh_reads);
   ccomm_close(c);

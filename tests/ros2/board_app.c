@@ -55,8 +55,7 @@ static void print_value(const ccomm_signal_desc* d, const unsigned char* buf) {
 }
 
 static void sleep_until(int64_t t) {
-  struct timespec ts = {(time_t)(t / 1000000000), (long)(t % 1000000000)};
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+  ccomm_sleep_until(t);
 }
 
 int main(int argc, char** argv) {
@@ -94,8 +93,7 @@ int main(int argc, char** argv) {
       for (;;) {
         rc = ccomm_write(c, s, buf, d.value_bytes);
         if (rc != CCOMM_E_FULL && rc != CCOMM_E_BUSY) break;
-        struct timespec ms = {0, 1000000};
-        nanosleep(&ms, NULL);
+        ccomm_sleep_until(ccomm_now() + 1000000);
       }
       if (rc) { fprintf(stderr, "board_app: write %ld: %s\n", k, ccomm_strerror(rc)); break; }
       ++written;

@@ -10,7 +10,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
+#include <stdint.h>
 
 #include "ccomm_4c.h"
 
@@ -25,7 +25,7 @@ int main(void) {
   double integral = 0.0;
   unsigned long cycles = 0, not_fresh = 0;
   struct sigaction sa;
-  struct timespec next;
+  int64_t next;
   int r;
 
   memset(&sa, 0, sizeof sa);
@@ -35,7 +35,7 @@ int main(void) {
 
   r = ccomm4c_initialize();
   if (r != 0) return 1;
-  clock_gettime(CLOCK_MONOTONIC, &next);
+  next = ccomm_now();
   while (!stop) {
     double pos, vel, ok, error;
     r = ccomm4c_input();
@@ -51,12 +51,8 @@ int main(void) {
     ccomm4c_set(CCOMM4C_OUT_ERROR_INTEGRAL, integral);
     if (ccomm4c_output() < 0) break;
     cycles++;
-    next.tv_nsec += (long)(h * 1e9);
-    if (next.tv_nsec >= 1000000000L) {
-      next.tv_nsec -= 1000000000L;
-      next.tv_sec++;
-    }
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL) != 0 && !stop) {
+    next += (int64_t)(h * 1e9);
+    while (ccomm_sleep_until(next) != 0 && !stop) {
     }
   }
   ccomm4c_terminate();

@@ -12,7 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 static double kp = 2.0; /* argv[2] overrides: the task was started with --param kp=... */
 static const double kd = 0.5, reference = 1.0;
@@ -20,18 +19,9 @@ static ccomm_client* c;
 static ccomm_signal s_pos, s_vel, s_sp, s_int;
 static int failures = 0;
 
-static double now_s(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double now_s(void) { return 1e-9 * (double)ccomm_now(); }
 
-static void sleep_s(double s) {
-  struct timespec t;
-  t.tv_sec = (time_t)s;
-  t.tv_nsec = (long)((s - (double)t.tv_sec) * 1e9);
-  nanosleep(&t, NULL);
-}
+static void sleep_s(double s) { ccomm_sleep_until(ccomm_now() + (int64_t)(s * 1e9)); }
 
 /* Writes the plant outputs at 200 Hz for `seconds` (or only sleeps if write == 0). */
 static void play(double pos, double vel, double seconds, int write) {

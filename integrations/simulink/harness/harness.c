@@ -6,7 +6,7 @@
  * mdlTerminate; mdlRTW for code generation) against a running ccommd, and checks what
  * the blocks output. Usage: simulink_harness NODE (ccommd running harness/signals.xml).
  */
-#define _POSIX_C_SOURCE 200809L /* setenv, nanosleep */
+#define _POSIX_C_SOURCE 200809L /* setenv, clock_gettime */
 #define S_FUNCTION_NAME harness
 #define S_FUNCTION_LEVEL 2
 #include <ccomm/ccomm.h>
@@ -43,12 +43,7 @@ typedef struct {
   real_T in[64], out0[64], out1[64]; /* port buffers; typed ports use them as raw memory */
 } block;
 
-static void sleep_ms(int ms) {
-  struct timespec t;
-  t.tv_sec = ms / 1000;
-  t.tv_nsec = (long)(ms % 1000) * 1000000L;
-  nanosleep(&t, NULL);
-}
+static void sleep_ms(int ms) { ccomm_sleep_until(ccomm_now() + (int64_t)ms * 1000000); }
 
 /* The parameters of a block from the masked library (7) or of an older model (4). */
 typedef struct {

@@ -31,6 +31,7 @@ from ._errors import (
 )
 from .client import Client, Reading, Signal, SignalInfo, SignalType, Status
 from .history import History, HistoryReading
+from .realtime import RealtimeResult, realtime_setup, sleep_until
 
 # The one version of the Python package: pyproject.toml reads it, and scripts/package
 # checks that it equals the CMake project version and debian/changelog.
@@ -40,9 +41,9 @@ __all__ = [
     "BusyError", "CcommError", "Client", "CorruptError", "DaemonNotRunningError", "History", "HistoryReading",
     "InvalidArgumentError",
     "LibraryNotFoundError",
-    "NotFoundError", "NotProducerError", "QueueFullError", "Reading", "RetiredError", "Signal",
+    "NotFoundError", "NotProducerError", "QueueFullError", "Reading", "RealtimeResult", "RetiredError", "Signal",
     "SignalInfo", "SignalType", "Status", "SystemCallError", "TypeMismatchError", "VersionError",
-    "find_library", "library_path", "open",
+    "find_library", "library_path", "open", "realtime_setup", "sleep_until",
 ]
 
 

@@ -306,6 +306,9 @@ def _declare(L: ctypes.CDLL) -> ctypes.CDLL:
         "ccomm_wait": ([vp, c_int], c_int),
         "ccomm_set_time": ([vp, i64], c_int),
         "ccomm_now": ([], i64),
+        "ccomm_realtime_setup": ([i32, i32, i32, ctypes.POINTER(i32)], c_int),
+        # ctypes releases the GIL here too: the sleep holds up no other thread.
+        "ccomm_sleep_until": ([i64], c_int),
         "ccomm_daemon_alive": ([vp], c_int),
         "ccomm_daemon_generation": ([vp], u32),
         "ccomm_get_signal_stats_sized": ([vp, i32, vp, sz], c_int),

@@ -32,6 +32,7 @@ from . import _native, _view
 from ._tool_args import fifo_priority
 from ._errors import E_CORRUPT, CcommError, error_text
 from .client import Client, SignalInfo
+from .realtime import realtime_setup
 from .mcap_io.schema import FLAG_INITIAL, RECORD, WATERMARK_ID
 
 EXAMPLES = """\
@@ -133,10 +134,9 @@ def select_signals(all_signals: List[SignalInfo], patterns: List[str], node: str
 
 def _set_priority(prio: int) -> None:
     if prio > 0:
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio))
-        except OSError as e:
-            print(f"record: cannot use SCHED_FIFO priority {prio} ({e.strerror}); "
+        err = realtime_setup(priority=prio).priority
+        if err:
+            print(f"record: cannot use SCHED_FIFO priority {prio} ({os.strerror(-err)}); "
                   "recording at normal priority", file=sys.stderr)
 
 

@@ -21,6 +21,7 @@ from . import _native
 from ._tool_args import fifo_priority
 from ._errors import E_BUSY, E_FULL, CcommError, error
 from .client import Client, SignalInfo
+from .realtime import realtime_setup
 
 if TYPE_CHECKING:
     from .mcap_io.recording import Recording
@@ -229,18 +230,6 @@ def _usage() -> Dict[str, int]:
     return {"major_faults": u.ru_majflt, "minor_faults": u.ru_minflt, "preempted": u.ru_nivcsw}
 
 
-def _lock_memory() -> bool:
-    """mlockall(MCL_CURRENT | MCL_FUTURE), as a real-time task does: no page of the
-    interpreter, the timeline or what the loop allocates is faulted in or out while it
-    times. False where not permitted (RLIMIT_MEMLOCK without CAP_IPC_LOCK)."""
-    if sys.platform != "linux":
-        return False
-    try:
-        return int(ctypes.CDLL(None).mlockall(1 | 2)) == 0
-    except (OSError, AttributeError):
-        return False
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     a = parse_args(argv)
     if not require_mcap("replay"):
@@ -289,18 +278,21 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     stop: List[int] = []
     for s in (signal.SIGINT, signal.SIGTERM):
         signal.signal(s, lambda *_: stop.append(1))
-    if a.priority > 0:
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(a.priority))
-        except OSError as e:
-            print(f"replay: cannot use SCHED_FIFO priority {a.priority} ({e.strerror})", file=sys.stderr)
     # The timeline is hundreds of thousands of objects: a full garbage collection walking
     # them takes milliseconds, in the middle of the timing. Replaying makes no cycles, so
     # what exists is set aside and collection stays off until the end.
     gc.collect()
     gc.freeze()
     gc.disable()
-    locked = _lock_memory() if a.priority > 0 else False
+    # As a real-time task does (with --priority): no page of the interpreter, the timeline
+    # or what the loop allocates is faulted in or out while it times.
+    locked = False
+    if a.priority > 0:
+        rt = realtime_setup(lock_memory=True, priority=a.priority)
+        locked = rt.lock_memory == 0
+        if rt.priority:
+            print(f"replay: cannot use SCHED_FIFO priority {a.priority} ({os.strerror(-rt.priority)})",
+                  file=sys.stderr)
     before = _usage()
     try:
         written, late, why_late = replay(c, timeline, a.rate, a.loop, stop, a.quiet)

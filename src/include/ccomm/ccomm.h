@@ -209,6 +209,30 @@ CCOMM_API int ccomm_set_time(ccomm_client* c, int64_t t_ns);
 CCOMM_API int64_t ccomm_now(void);
 
 /**
+ * Real-time set-up of the calling thread, for an application's own control loop: the one
+ * ccommd and ccomm's programs use, one implementation per platform, in this order: the
+ * CPU `cpu` (< 0: leave it), the memory lock (`lock_memory` nonzero: current and future
+ * memory), the priority (`fifo_priority` 1..99: SCHED_FIFO; 0: leave it). POSIX:
+ * pthread_setaffinity_np, mlockall(MCL_CURRENT | MCL_FUTURE), pthread_setschedparam;
+ * Windows: SetThreadAffinityMask, a larger working set, THREAD_PRIORITY_TIME_CRITICAL.
+ * `errors` (NULL: not wanted) gets each part's result in that order: 0 (also for a part not
+ * asked for) or a negative errno (-EPERM: not permitted; root, or CAP_SYS_NICE and
+ * CAP_IPC_LOCK, or limits.conf's rtprio and memlock). Returns 0 if every part asked for
+ * was done, else CCOMM_E_SYS: the parts that could be done are, and the loop may run
+ * without the others. Not real-time: call it once, before the loop.
+ */
+CCOMM_API int ccomm_realtime_setup(int32_t cpu, int32_t lock_memory, int32_t fifo_priority, int32_t errors[3]);
+
+/**
+ * Sleeps until ccomm_now() reaches `deadline_ns` (absolute: a periodic loop adds its period
+ * to the deadline and keeps its rate whatever a cycle took; a deadline already past returns
+ * at once). Returns 0 at the deadline, 1 if a signal handler ran first (check the stop flag,
+ * then sleep again), CCOMM_E_INVAL for a negative deadline. A system call: the loop's one
+ * wait between cycles, not for inside one.
+ */
+CCOMM_API int ccomm_sleep_until(int64_t deadline_ns);
+
+/**
  * Blocks until any signal of this node has changed (a value arrived from the network or
  * was written locally) since the previous ccomm_wait() on this handle returned (or since
  * ccomm_open), or `timeout_ms` passes (< 0: forever; 0: just look). Returns 1 if

@@ -180,6 +180,12 @@ class Client : private detail::Owned<ccomm_client> {
   /// Cycle time for this handle's reads and writes (see ccomm_set_time); 0 = per call.
   void set_time(int64_t t_ns) { ccomm_set_time(h_, t_ns); }
   static int64_t now() { return ccomm_now(); }
+  /// Real-time set-up of the calling thread (ccomm_realtime_setup; cpu < 0 and 0 leave a part).
+  static int realtime_setup(int32_t cpu, bool lock_memory, int32_t fifo_priority, int32_t errors[3] = nullptr) {
+    return ccomm_realtime_setup(cpu, lock_memory ? 1 : 0, fifo_priority, errors);
+  }
+  /// Sleeps until ccomm_now() reaches deadline_ns (ccomm_sleep_until): 0, or 1 after a signal.
+  static int sleep_until(int64_t deadline_ns) { return ccomm_sleep_until(deadline_ns); }
 
   /// Blocks until something changes (non-real-time consumers).
   bool wait(int timeout_ms) { return ccomm_wait(h_, timeout_ms) == 1; }

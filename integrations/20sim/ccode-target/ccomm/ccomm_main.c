@@ -7,7 +7,8 @@
  *   1. reads every input port from the ccomm signal of the same name,
  *   2. calls XXCalculateSubmodel,
  *   3. writes every output port to the ccomm signal of the same name.
- * Timing: SCHED_FIFO, mlockall, absolute clock_nanosleep on CLOCK_MONOTONIC; a period
+ * Timing: ccomm_realtime_setup (CPU, memory lock, SCHED_FIFO: libccomm's one set-up, the
+ * same on Windows) and ccomm_sleep_until, an absolute sleep on ccomm_now()'s clock; a period
  * that ends after the next release counts as an overrun and the missed releases are
  * skipped (the loop keeps its phase instead of running a burst of late cycles).
  * Inputs that are stale or never received give the signal's safe value when ccommd has
@@ -22,17 +23,13 @@
  */
 #define _GNU_SOURCE
 #include <ccomm/ccomm.h>
-#include <errno.h>
 #include <getopt.h>
 #include <math.h>
-#include <sched.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "ccomm_map.h"
@@ -106,14 +103,6 @@ typedef struct {
 } task_stats;
 
 static task_stats stats;
-
-static int64_t ts_ns(const struct timespec* t) { return (int64_t)t->tv_sec * 1000000000 + t->tv_nsec; }
-static struct timespec ns_ts(int64_t ns) {
-  struct timespec t;
-  t.tv_sec = (time_t)(ns / 1000000000);
-  t.tv_nsec = (long)(ns % 1000000000);
-  return t;
-}
 
 static void print_stats(FILE* f) {
   fprintf(f,
@@ -262,37 +251,19 @@ static int parse_args(int argc, char** argv) {
 
 /* Real-time set-up; returns 0 only when --require-rt and something failed. */
 static int setup_realtime(void) {
-  int ok = 1;
-  if (opt.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(opt.cpu, &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0) {
-      fprintf(stderr, "%s: cannot pin to CPU %d: %s\n", ccomm_xx_submodel_name, opt.cpu, strerror(errno));
-      ok = 0;
-    }
+  int32_t err[3];
+  const int ok = ccomm_realtime_setup(opt.cpu, !opt.no_mlock, opt.priority, err) == 0;
+  if (err[0]) fprintf(stderr, "%s: cannot pin to CPU %d: %s\n", ccomm_xx_submodel_name, opt.cpu, strerror(-err[0]));
+  if (err[1]) fprintf(stderr, "%s: cannot lock memory: %s\n", ccomm_xx_submodel_name, strerror(-err[1]));
+  if (!opt.no_mlock && !err[1]) {
+    /* Fault the stack in now so the loop never page-faults on it. */
+    volatile unsigned char stack[128 * 1024];
+    size_t i;
+    for (i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
   }
-  if (!opt.no_mlock) {
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-      fprintf(stderr, "%s: mlockall failed: %s\n", ccomm_xx_submodel_name, strerror(errno));
-      ok = 0;
-    } else {
-      /* Fault the stack in now so the loop never page-faults on it. */
-      volatile unsigned char stack[128 * 1024];
-      size_t i;
-      for (i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
-    }
-  }
-  if (opt.priority > 0) {
-    struct sched_param sp;
-    memset(&sp, 0, sizeof sp);
-    sp.sched_priority = opt.priority;
-    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
-      fprintf(stderr, "%s: SCHED_FIFO priority %d refused (%s); running with normal scheduling\n",
-              ccomm_xx_submodel_name, opt.priority, strerror(errno));
-      ok = 0;
-    }
-  }
+  if (err[2])
+    fprintf(stderr, "%s: SCHED_FIFO priority %d refused (%s); running with normal scheduling\n",
+            ccomm_xx_submodel_name, opt.priority, strerror(-err[2]));
   return ok || !opt.require_rt;
 }
 
@@ -302,9 +273,8 @@ static int setup_realtime(void) {
  * stale inputs (safe values) and exit as if all went well. */
 static int open_running_ccommd(ccomm_client** out) {
   const char* node = opt.node ? opt.node : "(default node)";
-  struct timespec t0, now, pause = {0, 100000000};
+  const int64_t t0 = ccomm_now();
   int rc;
-  clock_gettime(CLOCK_MONOTONIC, &t0);
   for (;;) {
     rc = ccomm_open(opt.node, opt.no_doorbell ? CCOMM_OPEN_NO_DOORBELL : 0, out);
     if (rc == 0 && ccomm_daemon_alive(*out)) return 0;
@@ -315,9 +285,8 @@ static int open_running_ccommd(ccomm_client** out) {
       fprintf(stderr, "%s: ccomm_open(%s): %s\n", ccomm_xx_submodel_name, node, ccomm_strerror(rc));
       return rc;
     }
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    if (ts_ns(&now) - ts_ns(&t0) >= (int64_t)llround(opt.wait_ccommd * 1e9) || stop_requested) break;
-    nanosleep(&pause, NULL);
+    if (ccomm_now() - t0 >= (int64_t)llround(opt.wait_ccommd * 1e9) || stop_requested) break;
+    ccomm_sleep_until(ccomm_now() + 100000000);
   }
   fprintf(stderr,
           "%s: no ccommd is running for node %s (%s after %g s): start it (systemctl start ccommd)\n"
@@ -364,9 +333,7 @@ int main(int argc, char** argv) {
     return 3;
   }
 
-  struct timespec now;
-  clock_gettime(CLOCK_MONOTONIC, &now);
-  const int64_t start_ns = ts_ns(&now);
+  const int64_t start_ns = ccomm_now();
   int64_t next_ns = start_ns + period_ns;
   const int64_t end_ns = opt.duration > 0.0 ? start_ns + (int64_t)llround(opt.duration * 1e9) : INT64_MAX;
   int64_t next_alive_check_ns = start_ns + 1000000000;
@@ -374,11 +341,8 @@ int main(int argc, char** argv) {
   int64_t next_stats_ns = opt.stats_interval > 0.0 ? start_ns + (int64_t)llround(opt.stats_interval * 1e9) : INT64_MAX;
 
   while (!stop_requested) {
-    struct timespec release = ns_ts(next_ns);
-    int s = clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &release, NULL);
-    if (s == EINTR) continue; /* a signal: re-check stop_requested, then sleep again */
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    const int64_t wake_ns = ts_ns(&now);
+    if (ccomm_sleep_until(next_ns) == 1) continue; /* a signal: re-check stop_requested, then sleep again */
+    const int64_t wake_ns = ccomm_now();
     if (wake_ns - next_ns > stats.max_late_ns) stats.max_late_ns = wake_ns - next_ns;
     /* The step's time for all its reads (freshness) and writes (time stamps): one clock
      * reading per step instead of one per signal access. */
@@ -390,8 +354,7 @@ int main(int argc, char** argv) {
     if (ccomm_xx_write_outputs(c, y, &stats.io) != 0) { exit_code = 3; break; }
     stats.cycles++;
 
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    const int64_t done_ns = ts_ns(&now);
+    const int64_t done_ns = ccomm_now();
     if (done_ns - wake_ns > stats.max_exec_ns) stats.max_exec_ns = done_ns - wake_ns;
     next_ns += period_ns;
     if (done_ns > next_ns) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The POSIX unit of common/platform_app.h's exclusive lock (ccommd's node, ccomm-ros2's
+// The POSIX unit of common/public/platform_app.h's exclusive lock (ccommd's node, ccomm-ros2's
 // node and DDS domain), and the group its object gets.
 #include <errno.h>
 #include <fcntl.h>
@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace ccomm {
 namespace platform {

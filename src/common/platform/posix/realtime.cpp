@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The POSIX unit of common/platform_app.h's clock, sleeps and real-time set-up (Linux,
+// The POSIX unit of common/public/platform_app.h's clock, sleeps and real-time set-up (Linux,
 // glibc; Xenomai's POSIX skin wraps these calls in ccommd).
 #include <errno.h>
 #include <pthread.h>
@@ -8,7 +8,7 @@
 #include <sys/mman.h>
 #include <time.h>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace ccomm {
 namespace platform {

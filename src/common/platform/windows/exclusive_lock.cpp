@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// The Windows unit of common/platform_app.h's exclusive lock (ccommd's node), and the
+// The Windows unit of common/public/platform_app.h's exclusive lock (ccommd's node), and the
 // group of an object (none).
 #include <errno.h>
 #include <stdio.h>
 
 #include <windows.h>
 
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace ccomm {
 namespace platform {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The Windows unit of common/platform_app.h's clock, sleeps and real-time set-up: what
+// The Windows unit of common/public/platform_app.h's clock, sleeps and real-time set-up: what
 // Windows offers in place of CLOCK_MONOTONIC, nanosleep, mlockall and SCHED_FIFO.
 #include <errno.h>
 
@@ -8,7 +8,7 @@
 // clang-format on
 
 #include "common/platform/windows/errno_of.h"
-#include "common/platform_app.h"
+#include "common/public/platform_app.h"
 
 namespace ccomm {
 namespace platform {

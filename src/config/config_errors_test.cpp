@@ -35,6 +35,21 @@ std::vector<std::string> Lines(const std::string& s) {
   return out;
 }
 
+// One row of an edge-case table: XML either parses (error == nullptr) or is refused with a
+// message that contains `error` and starts with "t.xml:LINE: error: ".
+void ExpectParseOutcome(const std::string& xml, int line, const char* error, const std::string& label) {
+  SystemConfig cfg;
+  std::string err;
+  bool ok = ParseConfig(xml, "t.xml", &cfg, &err);
+  if (error == nullptr) {
+    EXPECT_TRUE(ok) << label << ": " << err;
+  } else {
+    EXPECT_FALSE(ok) << label;
+    EXPECT_NE(err.find(error), std::string::npos) << label << ": got " << err;
+    EXPECT_EQ(err.rfind("t.xml:" + std::to_string(line) + ": error: ", 0), 0u) << err;
+  }
+}
+
 // ------------------------------------------------------------- inline edge cases
 
 struct EdgeCase {
@@ -124,16 +139,7 @@ TEST(Parse, SignalAttributeEdgeCases) {
         attrs.find("consumers=") == std::string::npos ? "consumers=\"b\" " : "";
     std::string xml =
         TwoNodes("  <signal name=\"s\" producer=\"a\" " + consumers + attrs + "/>");
-    SystemConfig cfg;
-    std::string err;
-    bool ok = ParseConfig(xml, "t.xml", &cfg, &err);
-    if (c.error == nullptr) {
-      EXPECT_TRUE(ok) << c.signal_attrs << ": " << err;
-    } else {
-      EXPECT_FALSE(ok) << c.signal_attrs;
-      EXPECT_NE(err.find(c.error), std::string::npos) << c.signal_attrs << ": got " << err;
-      EXPECT_EQ(err.rfind("t.xml:4: error: ", 0), 0u) << err;
-    }
+    ExpectParseOutcome(xml, 4, c.error, c.signal_attrs);
   }
 }
 
@@ -196,16 +202,7 @@ TEST(Parse, NetworkAndNodeEdgeCases) {
   for (const auto& c : cases) {
     std::string xml = std::string("<ccomm version=\"1\">\n") + c.xml_fragment +
                       "\n  <node name=\"b\" interface=\"eth0\"/>\n</ccomm>\n";
-    SystemConfig cfg;
-    std::string err;
-    bool ok = ParseConfig(xml, "t.xml", &cfg, &err);
-    if (c.error == nullptr) {
-      EXPECT_TRUE(ok) << c.xml_fragment << ": " << err;
-    } else {
-      EXPECT_FALSE(ok) << c.xml_fragment;
-      EXPECT_NE(err.find(c.error), std::string::npos) << c.xml_fragment << ": got " << err;
-      EXPECT_EQ(err.rfind("t.xml:2: error: ", 0), 0u) << err;
-    }
+    ExpectParseOutcome(xml, 2, c.error, c.xml_fragment);
   }
 }
 

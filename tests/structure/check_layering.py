@@ -324,6 +324,10 @@ def public_interfaces(src, errors):
 
 
 def main():
+    if len(sys.argv) != 3 or not os.path.isdir(sys.argv[1]) or not os.path.isdir(sys.argv[2]):
+        sys.stderr.write("usage: check_layering.py SOURCE_DIR BUILD_DIR (a configured and built tree, "
+                         "e.g. build/release)\n")
+        return 2
     src, build = sys.argv[1], sys.argv[2]
     errors = []
     application_includes(src, errors)

@@ -74,7 +74,7 @@ def tables(R, meta):
     if idle:
         nodes = [k for k in idle if k != "wall_s"]
         out.append("Idle (both setup-simulation daemons up, no application, heartbeats every 100 ms, "
-                   "supervision every 10 ms) for %.1f s:\n" % idle["wall_s"])
+                   "supervision every 100 ms when idle) for %.1f s:\n" % idle["wall_s"])
         out.append(md_table(["daemon", "CPU ms (stat)", "CPU ms (schedstat)", "µs CPU per s", "% of a CPU"],
                           [[n, "%.0f" % idle[n]["cpu_ms_ticks"], "%.2f" % idle[n]["cpu_ms_sched"],
                             "%.0f" % (idle[n]["cpu_ms_sched"] * 1000 / idle["wall_s"]),

@@ -430,7 +430,7 @@ DAEMON_FUNCTIONS = [
     ("send: finish and send one frame (user part of sendto)", "SendPath::FlushPeer("),
     ("receive: validate one frame and store its entries", "ReceivePath::HandleFrame("),
     ("receive: one transport receive call (user part of recvfrom)", "RawRecv("),
-    ("supervision tick (every 10 ms)", "Supervisor::Tick("),
+    ("supervision tick", "Supervisor::Tick("),
 ]
 
 CLIENT_FUNCTIONS = [

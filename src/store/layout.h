@@ -59,7 +59,7 @@ struct alignas(kCacheLine) SegmentHeader {
   std::atomic<uint32_t> state;       // SegmentState
   std::atomic<uint32_t> generation;  // +1 each time a ccommd attaches
   std::atomic<int32_t> daemon_pid;   // 0 when no daemon
-  std::atomic<uint64_t> daemon_heartbeat_ns;  // ccommd's CLOCK_MONOTONIC, every 10 ms
+  std::atomic<uint64_t> daemon_heartbeat_ns;  // ccommd's CLOCK_MONOTONIC, each supervision tick (<= 100 ms)
 
   // Send path doorbell: writers of forwarded signals set their dirty bit, bump
   // tx_doorbell and FUTEX_WAKE it only if ccommd said it is about to sleep.

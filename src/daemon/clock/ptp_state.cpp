@@ -134,6 +134,13 @@ bool Monitor::Evaluate(uint64_t now_ns) {
   return changed;
 }
 
+uint64_t Monitor::NextDueNs() const {
+  if (path_.empty()) return UINT64_MAX;
+  if (awaited_) return 0;
+  const uint64_t lost = last_answer_ns_ ? last_answer_ns_ + kLostAfterNs + 1 : UINT64_MAX;
+  return next_poll_ns_ < lost ? next_poll_ns_ : lost;
+}
+
 bool Monitor::Tick(uint64_t now_ns) {
   Drain(now_ns);
   if (now_ns >= next_poll_ns_) {

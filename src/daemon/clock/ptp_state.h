@@ -2,7 +2,7 @@
 // This board's clock synchronisation as linuxptp's ptp4l sees it, read over ptp4l's
 // management socket (a Unix datagram socket, /var/run/ptp4l by default: what
 // `pmc -u -b 0 'GET TIME_STATUS_NP'` and `'GET PORT_DATA_SET'` ask). ccommd's supervision
-// thread calls Tick() every 10 ms; it sends a query once a second and takes answers
+// thread calls Tick() on its ticks (every 10 ms while answers are due, NextDueNs); it sends a query once a second and takes answers
 // without ever blocking, so a slow or dead ptp4l costs nothing on any real-time path.
 //
 // States (docs/design.md, "Time"):
@@ -93,6 +93,10 @@ class Monitor {
 
   // Supervision thread, every tick: never blocks. True when the state changed.
   bool Tick(uint64_t now_ns);
+  // When Tick next has something to do (the supervision's schedule): at once (0) while
+  // answers to the last poll are due, else the next poll or the instant the last answer
+  // grows too old (kLostAfterNs); UINT64_MAX if never asked.
+  uint64_t NextDueNs() const;
   // The pieces of Tick, for tests: an answer arrived / time passed.
   void Answer(const Reply& r, uint64_t now_ns);
   bool Evaluate(uint64_t now_ns);

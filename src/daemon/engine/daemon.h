@@ -58,8 +58,10 @@ class Daemon {
   int Start(const SystemConfig& cfg, uint32_t node_id, const DaemonOptions& opt, std::string* error);
   void RunTx();   // send thread body, returns after RequestStop()
   void RunRx();   // receive thread body
-  /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call every ~10 ms.
+  /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call again at
+  /// NextSupervisionNs() (Supervisor::NextTickNs: 10 ms while busy, at most 100 ms idle).
   void Supervise(uint64_t now_ns) { supervisor_.Tick(now_ns); }
+  uint64_t NextSupervisionNs() const { return supervisor_.NextTickNs(); }
   /// What supervision hands the receive thread for stale_by="production" (tests call it too).
   void PublishSelfClock(bool synced, int64_t realtime_offset_ns) {
     handoffs_.PublishSelfClock(synced, realtime_offset_ns);

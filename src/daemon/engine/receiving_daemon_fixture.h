@@ -36,7 +36,7 @@ class ReceivingDaemonTest : public ::testing::Test {
     to_.sin_family = AF_INET;
     to_.sin_port = htons(cfg_.network.udp_port);
     inet_pton(AF_INET, cfg_.nodes[0].ip.c_str(), &to_.sin_addr);
-    DaemonOptions opt;
+    DaemonOptions opt = opt_;
     opt.no_realtime = true;
     opt.recv_timeout_ms = 20;
     std::string err;
@@ -74,6 +74,7 @@ class ReceivingDaemonTest : public ::testing::Test {
   }
 
   SystemConfig cfg_;
+  DaemonOptions opt_;  // a test may set what StartDaemon passes on (realtime and recv timeout are the fixture's)
   Daemon daemon_;
   std::thread rx_;
   int tx_ = -1;

@@ -83,6 +83,11 @@ void Supervisor::Tick(uint64_t now) {
   }
   if (const uint32_t foreign = foreign_.Poll(now))
     h->daemon_counters[store::kFramesForeign].fetch_add(foreign, std::memory_order_relaxed);
+  // The next tick (NextTickNs): the earliest instant something below falls due.
+  uint64_t due = now + kIdleTickNs;
+  if (next_reclaim_ns_ < due) due = next_reclaim_ns_;
+  if (ctx_.transport.ops && next_drops_ns_ < due) due = next_drops_ns_;
+  if (other_version != other_version_logged_ && other_version_next_log_ns_ < due) due = other_version_next_log_ns_;
   for (uint32_t p = 0; p < ctx_.table.node_count(); ++p) {
     if (!ctx_.table.exchanges(p)) continue;
     store::PeerStats& ps = ctx_.segment.peer(p);
@@ -96,6 +101,8 @@ void Supervisor::Tick(uint64_t now) {
       ps.down_transitions.fetch_add(1, std::memory_order_relaxed);
       Log(LogLevel::kWarning, "peer '%s' lost: nothing received for %u ms", cfg_->nodes[p].name.c_str(),
           cfg_->network.peer_timeout_ms);
+    } else if (alive && last + peer_timeout_ns_ + 1 < due) {
+      due = last + peer_timeout_ns_ + 1;  // lost then, unless a frame comes first
     }
   }
   SuperviseClock(now);
@@ -104,10 +111,18 @@ void Supervisor::Tick(uint64_t now) {
     const SignalConfig& s = cfg_->signals[id];
     if (!s.stale_after_ms) continue;
     uint64_t last = ctx_.segment.stats(id).last_rx_ns.load(std::memory_order_relaxed);
-    bool fresh = !store::IsStale(last != 0, last < now ? now - last : 0, uint64_t{s.stale_after_ms} * 1000000);
+    const uint64_t stale_ns = uint64_t{s.stale_after_ms} * 1000000;
+    bool fresh = !store::IsStale(last != 0, last < now ? now - last : 0, stale_ns);
     if (fresh_[id] && !fresh) ctx_.segment.stats(id).stale_transitions.fetch_add(1, std::memory_order_relaxed);
     fresh_[id] = fresh;
+    if (fresh && last + stale_ns + 1 < due) due = last + stale_ns + 1;  // stale then, unless a value comes
   }
+  if (ctx_.view.next_due_ns() < due) due = ctx_.view.next_due_ns();
+  if (ptp_.NextDueNs() < due) due = ptp_.NextDueNs();
+  const uint64_t by_arrival = ctx_.handoffs.by_arrival_frames.load(std::memory_order_relaxed);
+  if (by_arrival != by_arrival_logged_ && by_arrival_next_log_ns_ < due) due = by_arrival_next_log_ns_;
+  const bool busy = now - ctx_.view.last_write_seen_ns() < kBusyForNs || ctx_.handoffs.send_cycle.enabled();
+  next_tick_ns_ = busy || due < now + kTickNs ? now + kTickNs : due;
 }
 
 // This board's clock state (ptp_state.h) into its segment, where ccomm_get_clock_state()

@@ -107,6 +107,7 @@ int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKin
     dests_.push_back(d);
   }
   next_ns_ = start_ns_;
+  last_write_seen_ns_ = start_ns_;  // the first second after a start ticks every 10 ms
   cycle_start_ns_ = start_ns_;
   next_part_ = 0;
   return 0;
@@ -132,6 +133,7 @@ uint32_t SystemViewWriter::Tick(uint64_t now) {
     if (w != rep.seen_writes) {
       rep.seen_writes = w;
       rep.last_change_ns = now;
+      last_write_seen_ns_ = now;
     }
   }
   if (now < next_ns_) return 0;

@@ -54,6 +54,11 @@ class SystemViewWriter {
   /// Time between two parts and the number of parts (0 if summaries are off).
   uint64_t interval_ns() const { return interval_ns_; }
   uint32_t parts() const { return parts_; }
+  /// For the supervision's schedule (Supervisor::NextTickNs): when Tick next sends a part
+  /// or refreshes this node's record, and the last tick that saw a produced signal's
+  /// writes advance (0: none yet), whose age it samples.
+  uint64_t next_due_ns() const { return next_ns_; }
+  uint64_t last_write_seen_ns() const { return last_write_seen_ns_; }
 
  private:
   struct Dest {
@@ -90,6 +95,7 @@ class SystemViewWriter {
   std::vector<Reported> reported_;
   std::vector<SenderState> senders_;
   uint64_t start_ns_ = 0, interval_ns_ = 0, next_ns_ = 0, cycle_start_ns_ = 0;
+  uint64_t last_write_seen_ns_ = 0;
   uint32_t parts_ = 0, next_part_ = 0;
   wire::SummaryHead head_;  // node-level part of the current cycle
   alignas(8) uint8_t buf_[wire::kMaxFrameSize];

@@ -345,8 +345,14 @@ int RunDaemon(int argc, char** argv) {
   const uint64_t watchdog_ns = opt.watchdog_ns;
   uint64_t last_ping = 0, last_tx = 0, last_rx = 0;
   Reloader reloader(daemon, opt, std::move(cfg_owner), node_id, &io);
+  // Until the supervision's next tick (Supervisor::NextTickNs), rounded up to the ms;
+  // with a watchdog, at most a quarter of its interval.
+  uint64_t next_tick = platform::MonotonicNs();
   for (;;) {
-    const stop::Request req = stop::Wait(reloader.WaitMs());
+    const uint64_t before = platform::MonotonicNs();
+    uint64_t wait_ns = next_tick > before ? next_tick - before : 0;
+    if (watchdog_ns && wait_ns > watchdog_ns / 4) wait_ns = watchdog_ns / 4;
+    const stop::Request req = stop::Wait(reloader.WaitMs(static_cast<int>((wait_ns + 999999) / 1000000)));
     if (req == stop::Request::kStop) break;
     if (reloader.Handle(req) == ReloadOutcome::kBroken) {
       daemon.Shutdown();
@@ -354,6 +360,7 @@ int RunDaemon(int argc, char** argv) {
     }
     uint64_t now = platform::MonotonicNs();
     daemon.Supervise(now);
+    next_tick = daemon.NextSupervisionNs();
     // Ping the watchdog only while both I/O loops make progress.
     if (watchdog_ns && now - last_ping >= watchdog_ns / 2) {
       uint64_t t = daemon.tx_loops(), x = daemon.rx_loops();

@@ -21,10 +21,11 @@ constexpr uint64_t kSwitchHorizonNs = 600ull * 1000000000;
 
 }  // namespace
 
-int Reloader::WaitMs() const {
-  if (!armed_.cfg) return 10;
+int Reloader::WaitMs(int tick_ms) const {
+  if (!armed_.cfg) return tick_ms;
   const uint64_t t = platform::RealtimeNs();
-  return armed_.at_ns <= t ? 0 : static_cast<int>(std::min<uint64_t>(10, (armed_.at_ns - t) / 1000000));
+  if (armed_.at_ns <= t) return 0;
+  return std::min(tick_ms, static_cast<int>(std::min<uint64_t>(10, (armed_.at_ns - t) / 1000000)));
 }
 
 ReloadOutcome Reloader::Handle(stop::Request req) {

@@ -36,9 +36,9 @@ class Reloader {
   Reloader(const Reloader&) = delete;
   Reloader& operator=(const Reloader&) = delete;
 
-  /// How long the main loop may wait for the next request: 10 ms, or less up to an armed
-  /// switch's instant (then it is met to the ms).
-  int WaitMs() const;
+  /// How long the main loop may wait for the next request: `tick_ms` (until the next
+  /// supervision tick), or less up to an armed switch's instant (then it is met to the ms).
+  int WaitMs(int tick_ms) const;
   /// After stop::Wait returned `req` (not kStop; kNone too): a reload, or a switch armed,
   /// and then a switch whose instant has come.
   ReloadOutcome Handle(stop::Request req);

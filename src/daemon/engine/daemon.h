@@ -35,7 +35,7 @@ struct DaemonOptions {
   bool which_node = false;     // --which-node: print the node this board is and exit
   bool no_realtime = false;    // --no-rt: skip mlockall / SCHED_FIFO (tests, unprivileged)
   int verbosity = 6;           // LogLevel
-  int recv_timeout_ms = 50;
+  int recv_timeout_ms = 50;  // main.cpp: the platform's IdleRecvTimeoutMs (io_threads.h)
   std::string ptp_socket = "/var/run/ptp4l";  // --ptp-socket; empty: not asked (ptp_state.h)
   bool ptp_socket_given = false;               // --ptp-socket given: <clock socket=> does not apply
   bool clock_config = false;                   // --clock-config: print ptp4l.conf for the node, exit

@@ -461,7 +461,8 @@ void ReceivePath::RunRx() {
   while (ctx_.handoffs.running.load(std::memory_order_relaxed)) {
     ctx_.handoffs.rx_loops.fetch_add(1, std::memory_order_relaxed);
     if (!ctx_.transport.ops) {  // local-only node: nothing to receive
-      platform::SleepNs(uint64_t{static_cast<uint32_t>(recv_timeout_ms_)} * 1000 * 1000);
+      // Cut short by a stop or reload where the platform can (SIGUSR2, io_interrupt.cpp).
+      platform::SleepNsInterruptible(uint64_t{static_cast<uint32_t>(recv_timeout_ms_)} * 1000 * 1000);
       continue;
     }
     PeerAddress from;

@@ -30,5 +30,10 @@ void StopIo(Daemon& daemon, IoThreads* io);
 void PrepareIoInterrupt();
 /// Joins the receive thread `t`, cutting its blocking call short where the platform can.
 void JoinInterrupting(pthread_t t);
+/// How long the receive thread may wait in its socket while nothing arrives (each turn
+/// also counts for the watchdog, so main.cpp caps it at a quarter of the watchdog's
+/// interval): long where JoinInterrupting cuts the wait short (an idle receive thread then
+/// wakes only for frames), short where a stop has to wait it out.
+int IdleRecvTimeoutMs();
 
 }  // namespace ccomm

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -319,6 +320,10 @@ int RunDaemon(int argc, char** argv) {
   }
 
   opt.watchdog_ns = sd::WatchdogIntervalNs();
+  // The receive thread's socket timeout: its idle wake-ups, and the watchdog's proof that it turns.
+  opt.recv_timeout_ms = IdleRecvTimeoutMs();
+  if (opt.watchdog_ns && opt.watchdog_ns / 4000000 < static_cast<uint64_t>(opt.recv_timeout_ms))
+    opt.recv_timeout_ms = std::max(1, static_cast<int>(opt.watchdog_ns / 4000000));  // 0 would wait forever
   static Daemon daemon;  // large (frame buffers): not on the stack
   int r = daemon.Start(cfg, static_cast<uint32_t>(node), opt, &error);
   if (r != 0) {

@@ -14,6 +14,9 @@ void Interrupted(int) {}
 
 }  // namespace
 
+// A stop or a reload cuts the wait short (SIGUSR2): no need to wake for nothing.
+int IdleRecvTimeoutMs() { return 1000; }
+
 void PrepareIoInterrupt() {
   struct sigaction sa = {};
   sa.sa_handler = Interrupted;  // no SA_RESTART: the blocking call returns EINTR

@@ -5,6 +5,9 @@
 
 namespace ccomm {
 
+// A stop waits the receive thread's socket timeout out.
+int IdleRecvTimeoutMs() { return 50; }
+
 void PrepareIoInterrupt() {}
 void JoinInterrupting(pthread_t t) { pthread_join(t, nullptr); }
 

@@ -68,7 +68,7 @@ def tables(R, meta):
         out.append("Reading it: most of ccommd's CPU time is system time (the `sendto`/`recvfrom` calls into the "
                    "veth path, futex wake-ups), and it is paid per frame, so batching many signals into one "
                    "frame (setup-simulation) costs far less per signal than one signal per frame; at low rates "
-                   "the fixed part (heartbeats, the 10 ms supervision tick, see idle below) dominates. The "
+                   "the fixed part (heartbeats, the supervision tick, see idle below) dominates. The "
                    "\"idle subtracted\" column removes the idle CPU rate measured below.%s\n" % _periodic_cost(R))
     idle = cost.get("idle")
     if idle:

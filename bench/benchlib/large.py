@@ -45,7 +45,7 @@ def run_large(ctx, case):
         after = d.stats_all(list(names))
     sent = res["a"]["sent"]
     # CPU time (all threads) of each ccommd over the run, per value sent. It includes the
-    # daemons' background (10 ms supervision tick, heartbeats), the same at both sizes, so
+    # daemons' background (supervision tick, heartbeats), the same at both sizes, so
     # the difference between the 64 KiB and the 1 KiB row is what the fragments cost.
     per_value = {}
     for n, key in ((names[0], "cpu_tx_daemon_ns_per_value"), (names[1], "cpu_rx_daemon_ns_per_value")):

@@ -374,7 +374,7 @@ def why(R, check):
                 "%s %s µs, run %.2f times" % (role, _us(th[role]["run_ns"] / v), th[role]["times_run"] / v)
                 for role in ("send", "receive", "main") if role in th)
         return ("Per value, `%s` spent %s µs in its two application processes and %s µs in ccommd (both daemons, "
-                "every thread: send and receive threads, the 10 ms supervision tick and heartbeats included), "
+                "every thread: send and receive threads, the supervision tick and heartbeats included), "
                 "each counted over the measured window as the peer's are (the sender's send loop, the receiver "
                 "from its first value to its last; the daemons over the span of both); `%s` spent %s + %s µs in "
                 "its two processes. ccommd's share is the daemon design's price: the peer's library sends from "

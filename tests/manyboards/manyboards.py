@@ -214,10 +214,34 @@ def receive_losses(r, nodes):
                             env=r.env)
         try:
             d = json.loads(cp.stdout)
-            out[name] = (d["counters"].get("socket_drops", 0), sum(p["frames_lost"] for p in d.get("peers", [])))
+            out[name] = (d["counters"].get("socket_drops", 0), sum(p["frames_lost"] for p in d.get("peers", [])),
+                         {p["name"]: (p["frames_rx"], p["alive"]) for p in d.get("peers", [])})
         except (ValueError, KeyError, TypeError):
             out[name] = None
     return out
+
+
+def check_receive_work(r, n, nodes, fanout, losses, cycles):
+    """Multicast fan-out: a board receives the data of the boards it consumes from, and of a
+    board that only consumes from it nothing but heartbeats (it does not join that board's
+    group: docs/protocol.md, "Fan-out"), so its receive work follows what it consumes."""
+    a = r.args
+    if fanout != "multicast" or n < 3 or not all(losses.get(nm) for nm in nodes):
+        return
+    over = []
+    for j, name in enumerate(nodes):
+        if name == "mon":
+            continue
+        sources = {config.board(i) for i in config.producers_for(j, n, a.consumers)}
+        sinks = {config.board(i) for i in config.consumers_of(j, n, a.consumers)} - sources
+        for peer, (frames, alive) in losses[name][2].items():
+            if peer not in sinks:
+                continue
+            if frames >= cycles // 10 or frames == 0 or not alive:
+                over.append("%s got %d frames from %s (alive: %s), which only consumes from it"
+                            % (name, frames, peer, alive))
+    r.check(not over, "every board hears the boards that only consume from it by their heartbeats alone (alive, "
+            "1 to %d frames each, not their data)%s" % (cycles // 10 - 1, "" if not over else ": " + "; ".join(over[:4])))
 
 
 def cpu_pressure_total():
@@ -444,6 +468,7 @@ def system(args):
         sent1 = r.topo.sent_counts()
         losses = receive_losses(r, nodes)
         summary.update(check_counts(r, res, n, nodes, monitor, args.fanout, sent0, sent1, cycles, pressure, losses))
+        check_receive_work(r, n, nodes, args.fanout, losses, cycles)
         boards = [config.board(i) for i in range(n)]
         if all(res.values()):
             if args.latency:

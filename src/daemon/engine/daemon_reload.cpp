@@ -64,7 +64,7 @@ std::string Daemon::ReloadRefusal(const SystemConfig& next, uint32_t node_id) co
                                                    : "exchanging no signals any more (its socket)"));
   if (table_.multicast() || route.multicast()) {
     bool same = cur.nodes.size() == next.nodes.size();
-    for (uint32_t p = 0; same && p < next.nodes.size(); ++p) same = route.exchanges(p) == table_.exchanges(p);
+    for (uint32_t p = 0; same && p < next.nodes.size(); ++p) same = route.receives_from(p) == table_.receives_from(p);
     if (!same) refuse(now.line, node + "the peers of multicast fan-out (the joined groups)");
   }
   // Send on the cycle: set up on the socket at start (SO_TXTIME needs CAP_NET_ADMIN then).

@@ -15,11 +15,11 @@ void PreparedSignals::Route(const SystemConfig& cfg, uint32_t self) {
     signals_[i].producer = s.producer;
     bool consumed_here = false;
     for (uint32_t c : s.consumers) {
-      if (s.producer == self && c != self) exchanges_[c] = 1;
+      if (s.producer == self && c != self) exchanges_[c] |= kSendsTo;
       if (c == self) consumed_here = true;
     }
     // Heartbeats let the producer supervise us too.
-    if (s.producer != self && consumed_here) exchanges_[s.producer] = 1;
+    if (s.producer != self && consumed_here) exchanges_[s.producer] |= kReceivesFrom;
   }
 }
 

@@ -45,13 +45,28 @@ class PreparedSignals {
   const Signal* signals() const { return signals_.data(); }
   /// This node sends `node` signals or receives some from it (and heartbeats both ways).
   bool exchanges(uint32_t node) const { return exchanges_[node] != 0; }
+  /// `node` consumes a signal this node produces.
+  bool sends_to(uint32_t node) const { return (exchanges_[node] & kSendsTo) != 0; }
+  /// `node` produces a signal this node consumes.
+  bool receives_from(uint32_t node) const { return (exchanges_[node] & kReceivesFrom) != 0; }
   bool exchanges_any() const;
   /// fanout="multicast": one frame stream to this node's group instead of one per peer.
   bool multicast() const { return multicast_; }
+  /// Our frames reach `node` on a stream of its own: every peer with unicast fan-out; with
+  /// multicast, a peer that does not consume from us (so does not join our group) and only
+  /// gets our heartbeats, one per heartbeat period, so that it supervises us.
+  bool direct_stream(uint32_t node) const { return exchanges(node) && (!multicast_ || !sends_to(node)); }
+  /// That direct stream carries heartbeats only, to a raw peer without mac=: they go to the
+  /// station its frames come from (learned by the receive thread, ThreadHandoffs::
+  /// peer_station), never to the broadcast address (every board would get them).
+  bool learns_station(uint32_t node, bool raw_without_mac) const {
+    return raw_without_mac && multicast_ && direct_stream(node);
+  }
 
  private:
   std::vector<Signal> signals_;
-  std::vector<uint8_t> exchanges_;  // by node id
+  static constexpr uint8_t kSendsTo = 1, kReceivesFrom = 2;
+  std::vector<uint8_t> exchanges_;  // by node id: kSendsTo | kReceivesFrom
   bool multicast_ = false;
 };
 

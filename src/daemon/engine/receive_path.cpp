@@ -57,6 +57,7 @@ void ReceivePath::Prepare(const SystemConfig& cfg, uint32_t self, TransportKind 
     // address worth checking (any station can send any source MAC).
     if (ctx_.table.exchanges(p) && kind == TransportKind::kUdp && !cfg.nodes[p].ip.empty())
       platform::ParseIpv4(cfg.nodes[p].ip.c_str(), &peers_rx_[p].ipv4);
+    peers_rx_[p].learns_station = ctx_.table.learns_station(p, kind == TransportKind::kRaw && !cfg.nodes[p].has_mac);
   }
   history_.assign(n, store::RingView());
   rx_signals_.assign(n, RxSignal());
@@ -242,6 +243,16 @@ __attribute__((always_inline)) inline bool ReceivePath::ApplyEntry(RxSignal& rs,
   return true;
 }
 
+// Where our heartbeats to this peer go (PreparedSignals::learns_station): the station its
+// last accepted frame came from (a board replaced under the same node is followed).
+__attribute__((noinline)) void ReceivePath::LearnStation(uint32_t peer, const PeerAddress& from) {
+  uint64_t station = 0;
+  for (int i = 0; i < 6; ++i) station = station << 8 | from.mac[i];
+  std::atomic<uint64_t>& known = ctx_.handoffs.peer_station[peer];
+  if ((from.mac[0] & 1) == 0 && known.load(std::memory_order_relaxed) != station)
+    known.store(station, std::memory_order_relaxed);
+}
+
 void ReceivePath::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from) {
   wire::FrameHeader h;
   // One validation pass: entries of the signals this node takes cost one compare each.
@@ -296,6 +307,7 @@ void ReceivePath::HandleFrame(const uint8_t* buf, size_t len, uint64_t now, cons
   PeerRx& pr = peers_rx_[h.sender];
   AccountFrame(h, now);
   pr.last_rx_ns = now;
+  if (__builtin_expect(pr.learns_station, 0)) LearnStation(h.sender, from);
   ps.frames_rx.fetch_add(1, std::memory_order_relaxed);
   ps.last_seq.store(h.seq, std::memory_order_relaxed);
   ps.last_rx_ns.store(now, std::memory_order_release);

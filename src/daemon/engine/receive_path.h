@@ -55,6 +55,7 @@ class ReceivePath {
     FrameStream stream[2];      // [0]: frames addressed to us, [1]: broadcast
     uint64_t last_rx_ns = 0;    // our clock at its last accepted frame
     uint32_t ipv4 = 0;          // UDP: the configured source address (network order); 0 = any
+    bool learns_station = false;  // its frames' source MAC goes to the send thread (peer_station)
     PeerClock clock;            // its clock's offset floor: frames' queueing delays (peer_clock.h)
   };
   // Receiver rule 6: a signal's last applied value. The wire carries 32-bit sequence
@@ -93,6 +94,7 @@ class ReceivePath {
   };
 
   void HandleFrame(const uint8_t* buf, size_t len, uint64_t now, const PeerAddress& from);
+  void LearnStation(uint32_t peer, const PeerAddress& from);
   __attribute__((noinline)) bool HandleOtherEntry(const wire::FrameHeader& h, const uint8_t* entry, uint64_t now);
   bool ApplyEntry(RxSignal& rs, const uint8_t* entry, uint64_t now);
   __attribute__((noinline)) bool StoreEntry(const RxSignal& rs, const uint8_t* entry, const store::SlotMeta& meta);

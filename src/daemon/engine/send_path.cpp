@@ -44,6 +44,7 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
     if (!consumers_[i].empty() && s.period_us) periodic_.push_back(static_cast<uint32_t>(i));
   }
   const NodeConfig& me = cfg.nodes[self];
+  bool any_consumer = false;
   for (uint32_t p = 0; p < m; ++p) {
     PeerTx& pt = peers_tx_[p];
     if (!ctx_.table.exchanges(p)) continue;
@@ -60,14 +61,22 @@ int SendPath::OpenStreams(const SystemConfig& cfg, uint32_t self, TransportKind 
     }
     pt.writer = wire::FrameWriter(pt.buf, sizeof pt.buf);
     pt.dest = static_cast<uint16_t>(p);
-    pt.sends = !multicast;
+    // Multicast fan-out: a node joins the groups of the nodes it consumes from, and only
+    // those (a producer's group carries all its data, for every consumer). A peer that
+    // consumes from us hears our group; one that only produces for us does not join it,
+    // so our heartbeats go to it directly (PreparedSignals::direct_stream).
+    pt.sends = ctx_.table.direct_stream(p);
+    pt.learns_station = ctx_.table.learns_station(p, kind == TransportKind::kRaw && !cfg.nodes[p].has_mac);
     if (pt.sends) senders_.push_back(p);
-    if (multicast) groups->push_back(GroupAddressFor(cfg.network, p, kind));
+    if (multicast && ctx_.table.receives_from(p)) groups->push_back(GroupAddressFor(cfg.network, p, kind));
+    if (ctx_.table.sends_to(p)) any_consumer = true;
   }
-  if (multicast && !groups->empty()) {
+  if (multicast && ctx_.table.exchanges_any()) {
     // Every node's summary goes to the summary group, which every node with a socket
     // joins: any board sees the whole system (ccomm stats --all), not only its peers.
     if (cfg.network.summary_ms != 0) groups->push_back(GroupAddressFor(cfg.network, kSummaryGroup, kind));
+  }
+  if (multicast && any_consumer) {  // our own group: our data and, when idle, heartbeats
     PeerTx& g = peers_tx_[group_tx_];
     g.sends = true;
     g.dest = wire::kDestAll;
@@ -154,6 +163,15 @@ void SendPath::FlushPeer(uint32_t peer) {
   Count(ctx_.segment, store::kFramesTx);
   // Per-peer counts are for unicast streams; a group frame is counted once, in frames_tx.
   if (peer != group_tx_) ctx_.segment.peer(peer).frames_tx.fetch_add(1, std::memory_order_relaxed);
+}
+
+// A heartbeat-only stream to a raw peer without mac= goes to the station its frames come
+// from (ThreadHandoffs::peer_station); false until one came.
+bool SendPath::KnowsStation(uint32_t peer) {
+  const uint64_t station = ctx_.handoffs.peer_station[peer].load(std::memory_order_relaxed);
+  if (station == 0) return false;
+  for (int i = 0; i < 6; ++i) peers_tx_[peer].addr.mac[i] = static_cast<uint8_t>(station >> (8 * (5 - i)));
+  return true;
 }
 
 // Inline in CollectSignal: per signal, the common case is one store into an open frame.
@@ -369,8 +387,12 @@ void SendPath::RunTx() {
       if (pt.open) {
         FlushPeer(p);
       } else if (now - pt.last_tx_ns >= heartbeat_ns_) {
-        BeginFrame(p, now, wire::kFlagHeartbeat);
-        FlushPeer(p);
+        if (!pt.learns_station || KnowsStation(p)) {
+          BeginFrame(p, now, wire::kFlagHeartbeat);
+          FlushPeer(p);
+        } else {
+          pt.last_tx_ns = now;  // nowhere to send it yet: again a period later
+        }
       }
       uint64_t hb_due = pt.last_tx_ns + heartbeat_ns_;
       if (hb_due < next_deadline) next_deadline = hb_due;

@@ -58,6 +58,7 @@ class SendPath {
   // fanout="multicast", the one stream to this node's group (index group_tx_).
   struct PeerTx {
     bool sends = false;         // frames go out on this stream (data and heartbeats)
+    bool learns_station = false;  // heartbeats only, to a learned address (KnowsStation)
     uint16_t dest = 0;          // header dest: the peer's id, or wire::kDestAll for the group
     PeerAddress addr;
     uint32_t seq = 0;
@@ -114,6 +115,7 @@ class SendPath {
                     const void* value, uint64_t now);
   void BeginFrame(uint32_t peer, uint64_t now, uint8_t flags);
   void FlushPeer(uint32_t peer);
+  bool KnowsStation(uint32_t peer);
   // Large values (docs/protocol.md, "Large values"): one fragment entry per frame, after
   // the round's small entries.
   void SendLargeValues(uint64_t now);

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstdint>
 
+#include "config/config.h"
 #include "daemon/engine/send_cycle.h"
 #include "store/segment.h"
 
@@ -36,6 +37,10 @@ struct ThreadHandoffs {
   // another wire version (docs/protocol.md, "Versioning"), and the last one's
   // version << 16 | sender.
   std::atomic<uint64_t> by_arrival_frames{0};
+  // Receive thread -> send thread, multicast fan-out over raw Ethernet: the station
+  // address (MAC, 48 bits) that frames of a peer without mac= come from, for the peers
+  // whose heartbeats go to them directly (PreparedSignals::learns_station); 0 = none yet.
+  std::atomic<uint64_t> peer_station[kMaxNodes] = {};
   std::atomic<uint64_t> other_version_frames{0};
   std::atomic<uint32_t> other_version_last{0};
   // Send on the cycle (send_cycle.h): configured by the send part at start-up; then the

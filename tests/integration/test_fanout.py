@@ -101,6 +101,12 @@ def test_fanout(transport, fanout):
             # A consumer does not count the group entries it skips as errors.
             for n in ("c1", "c2", "m"):
                 assert counter(nodes.stats(n), "frames_not_for_us") == 0, (n, nodes.stats(n)["counters"])
+            # p joins no group (it consumes nothing) and still supervises its consumers: their
+            # heartbeats come to it directly (raw without mac=: to the station p's frames come
+            # from, never broadcast, as x's zero counters above show), one per period each.
+            peers = {q["name"]: q for q in nodes.stats("p")["peers"]}
+            for n in ("c1", "c2", "m"):
+                assert peers[n]["alive"] and 0 < peers[n]["frames_rx"] <= int(elapsed / 0.1) + 40, (n, peers[n])
 
 
 def test_consumer_of_more_producers_than_one_socket_may_join():

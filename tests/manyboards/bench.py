@@ -117,7 +117,7 @@ def render(rows, args, meta):
     L += ["", "How the design gets there: with `fanout=\"multicast\"` a producing board sends each cycle's values "
           "once, to its own group (raw: MAC 03:63:63:6d:00:ID; UDP: 239.255.67.ID), whatever the number of "
           "consumers, so its send cost does not grow with N (the test counts exactly one data frame per cycle "
-          "per board on the bridge). A board joins only the groups of the boards it exchanges signals with. "
+          "per board on the bridge). A board joins only the groups of the boards it consumes from (a board that only consumes from it sends it heartbeats directly, ten a second: the test checks that it gets no data frames from such a board). "
           "With UDP the bridge's IGMP snooping delivers it only those streams, so its receive cost follows what "
           "it consumes, not the size of the system. Raw Ethernet multicast is flooded by a plain bridge or "
           "unmanaged switch to every port; ccommd's packet socket carries a kernel socket filter for the "

@@ -209,6 +209,14 @@ RUNNERS = {"peer_net": run_net_peer, "peer_tput": run_throughput, "iox2": run_io
 
 # ---- targets and the report section ----
 
+def ccomm_row(transport, metric, payload, vs="dds"):
+    """The ccomm row a board-to-board peer class is judged against. Against DDS: the rows
+    measured in rounds alternating with DDS's (suite.PEER_CLASSES), named _vs_dds; against
+    another peer, the board-to-board section's row."""
+    base = "ccomm_%s_%s_block_1khz_p%d" % (transport, metric, payload)
+    return base + "_vs_dds" if vs == "dds" else base
+
+
 # (peer row, ccomm row it is judged against, class). Board to board the UDP peers are
 # judged against ccomm over UDP (same transport); 288 B RTT/2 only exists over raw.
 def pairs():
@@ -216,10 +224,10 @@ def pairs():
     for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("udp",))):
         for q in qoss:
             for p in (8, 288):
-                out.append(("%s_%s_oneway_1khz_p%d" % (peer, q, p), "ccomm_udp_oneway_block_1khz_p%d" % p,
+                out.append(("%s_%s_oneway_1khz_p%d" % (peer, q, p), ccomm_row("udp", "oneway", p, peer),
                             "board to board, one-way, 1 kHz"))
                 out.append(("%s_%s_rtt_half_1khz_p%d" % (peer, q, p),
-                            "ccomm_udp_rtt_half_block_1khz_p8" if p == 8 else "ccomm_raw_rtt_half_block_1khz_p288",
+                            ccomm_row("udp" if p == 8 else "raw", "rtt_half", p, peer),
                             "board to board, RTT/2, 1 kHz"))
     for p in (8, 288):
         out.append(("iox2_spin_b2b_p%d" % p, "ccomm_pp_state_spin_call_b2b_p%d" % p, "on-target, busy-poll"))
@@ -315,6 +323,18 @@ def section(R, meta, problems):
         L.append("|" + "|".join(["---"] + ["---:"] * 4 + ["---", "---:", "---:"]) + "|")
         L += ["| " + " | ".join(str(x) for x in l) + " |" for l in lines]
         L.append("")
+    split = [R.get(n) for n in (ccomm_row("udp", "oneway", 8), "dds_be_oneway_1khz_p8", "dds_rel_oneway_1khz_p8")]
+    if any(r and r.get("threads") for r in split):
+        L.append("Where the CPU of one value goes, one-way 8 B at 1 kHz over UDP, thread by thread (`bench/benchlib/"
+                 "threads.py`): in each round of these rows every thread of the programs was read from /proc once the "
+                 "traffic was steady and again a window later (run time from schedstat; user and system as the "
+                 "kernel's 100 Hz ticks, coarse; wake-ups = voluntary context switches, each one a sleep and a "
+                 "wake-up). Board A (CPU 0) sends, board B (CPU 1) receives. Per value the sender wrote in the "
+                 "windows. ccomm's path has one hand-off more than DDS's on the sending board (the application's "
+                 "`ccomm_flush()` wakes ccommd's send thread, which makes the `sendto`); DDS sends from the "
+                 "application's own thread and, like ccommd on board B, wakes a receive thread per packet.\n")
+        from . import threads
+        L += threads.table([r for r in split if r])
     tput = [r for r in R.rows if "throughput" in r["name"]]
     if tput:
         L.append("Throughput at 8 B, one way (steps: offered values/s -> lost). Not like for like in one respect: "

@@ -24,13 +24,16 @@ import re
 import time
 from dataclasses import dataclass, field
 
-from . import ccomm, floors, peers, results, runners
+from . import ccomm, floors, peers, results, runners, threads
 from .ccomm import Failed, Skip
 from .floors import Case
 from .runners import SPIN_SECONDS
 
 THESIS_RATES = (100, 200, 300, 400, 500, 600, 700, 800, 900, 1000, 10000)
 REPEAT = "~%d"  # name suffix of a repeated half; merge_repeats() joins them
+PEER_ROUNDS = 3  # rounds of the classes judged against DDS (full run)
+# (transport, metric, payload) of those classes: board to board, 1 kHz (peers.pairs()).
+PEER_CLASSES = (("udp", "oneway", 8), ("udp", "rtt_half", 8), ("udp", "oneway", 288), ("raw", "rtt_half", 288))
 floors.RUNNERS.update(peers.RUNNERS)
 
 
@@ -152,14 +155,43 @@ def plan(smoke=False, rates=None, scale=1.0):
     # and Zenoh (one-way and RTT/2, 1 kHz and back to back, 8 / 288 B; throughput at 8 B
     # until loss, each step at least min_values values so the loss limit means something),
     # on one machine iceoryx2 (busy-poll and listener/notifier). peers.py.
+    # The 1 kHz classes ccomm is judged in against DDS (peers.pairs()) are measured in
+    # rounds, each round ccomm then DDS best-effort then DDS reliable, class by class; each
+    # side's rounds are merged into one row (p50 over all samples, CPU per value over all
+    # values): the host's drift over the minutes of a run then reaches both sides alike.
+    rounds = (1,) if smoke else tuple(range(1, PEER_ROUNDS + 1))
+
+    def round_suffix(k):
+        return "" if smoke else REPEAT % k
+
+    def dds_class(q, p, role, suffix):
+        o = {"peer": "dds", "reliable": q == "rel"}
+        if role == "oneway":
+            return Case("dds_%s_oneway_1khz_p%d%s" % (q, p, suffix), "peer_net", "peers", n(2000, 200), p, 1000,
+                        dict(o, role="oneway"))
+        return Case("dds_%s_rtt_half_1khz_p%d%s" % (q, p, suffix), "peer_net", "peers", n(2000, 200), p, 1000,
+                    dict(o, role="rtt", half=True))
+
+    for k in rounds:
+        for t, role, p in PEER_CLASSES:
+            # One-way 8 B, the class of the thread split (threads.py), also read thread by thread.
+            split = {"threads": True} if not smoke and (t, role, p) == PEER_CLASSES[0] else {}
+            cases.append(CCase(peers.ccomm_row(t, role, p) + round_suffix(k), "peers", "ccomm_pair", d,
+                               dict({"transport": t, "signals": p // 8, "mode": "oneway" if role == "oneway" else "ping",
+                                     "style": "block", "rate": 1000}, **split)))
+            for q in ("be", "rel"):
+                c = dds_class(q, p, role, round_suffix(k))
+                c.opts.update(split)
+                cases.append(c)
     for peer, qoss in (("dds", ("be", "rel")), ("zenoh", ("udp",))):
         for q in qoss:
             o = {"peer": peer, "reliable": q == "rel"}
             for p in (8, 288):
-                cases.append(Case("%s_%s_oneway_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p, 1000,
-                                  dict(o, role="oneway")))
-                cases.append(Case("%s_%s_rtt_half_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p,
-                                  1000, dict(o, role="rtt", half=True)))
+                if peer != "dds":
+                    cases.append(Case("%s_%s_oneway_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p,
+                                      1000, dict(o, role="oneway")))
+                    cases.append(Case("%s_%s_rtt_half_1khz_p%d" % (peer, q, p), "peer_net", "peers", n(2000, 200), p,
+                                      1000, dict(o, role="rtt", half=True)))
                 cases.append(Case("%s_%s_rtt_half_b2b_p%d" % (peer, q, p), "peer_net", "peers", n(5000, 300), p, 0,
                                   dict(o, role="rtt", half=True)))
             cases.append(Case("%s_%s_throughput_p8" % (peer, q), "peer_tput", "peers", 1000, 8, 0,
@@ -214,6 +246,7 @@ SMOKE_CASES = {
     "thesis_single_event_1khz", "thesis_setup_event_1khz", "thesis_setup_periodic_1khz",
     "thesis_setup_event_spin_10khz",
     "dds_be_oneway_1khz_p8", "dds_rel_rtt_half_1khz_p8", "dds_be_throughput_p8", "ccomm_raw_throughput_p8",
+    "ccomm_udp_oneway_block_1khz_p8_vs_dds",
     "cost_idle", "cost_callgrind_single", "cost_callgrind_client", "large_raw_oneway_100hz_p65536",
 }
 
@@ -271,6 +304,16 @@ def merge_repeats(rows, outdir):
                         f.write(g.read())
             first["stages_raw"] = rel
             first["stages"] = ccomm.stages(os.path.join(outdir, rel))
+        # CPU per value over every part (each part's own figure weighted by its values), not
+        # the first part's alone; each part's figure kept beside it.
+        for key in ("cpu_ns_per_value", "cpu_ns_whole_per_value"):
+            if all(r.get(key) is not None and r.get("values") for r in parts):
+                first[key] = round(sum(r[key] * r["values"] for r in parts) / float(sum(r["values"] for r in parts)))
+                first["rep_" + key] = [r[key] for r in parts]
+        if all(r.get("values") for r in parts):
+            first["values"] = sum(r["values"] for r in parts)
+        if any(r.get("threads") for r in parts):
+            first["threads"] = [s for r in parts for s in (r.get("threads") or [])]
         first["seconds"] = round(sum(r.get("seconds", 0) for r in parts), 2)
         first["merged_from"] = [r["name"] for r in parts]
         first["rep_p50_ns"] = rep_p50
@@ -318,7 +361,21 @@ class Bench(floors.Context):
 
 
 def run_case(ctx, case):
-    """("ok", [rows]) or ("skipped"|"failed", reason)."""
+    """("ok", [rows]) or ("skipped"|"failed", reason). A case with opts["threads"] is
+    sampled thread by thread while it runs (threads.py): its row's "threads"."""
+    if not case.opts.get("threads"):
+        return _run_case(ctx, case)
+    sampler = threads.Sampler(rate_hz=case.opts.get("rate") or getattr(case, "rate", 0) or 1000).start()
+    try:
+        status, x = _run_case(ctx, case)
+    finally:
+        sample = sampler.stop()
+    if status == "ok":
+        x[0]["threads"] = [sample] if sample else []
+    return status, x
+
+
+def _run_case(ctx, case):
     if isinstance(case, Case):
         status, x = floors.run_case(ctx, case)
         if status == "failed":

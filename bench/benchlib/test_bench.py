@@ -84,7 +84,8 @@ class MergeTest(unittest.TestCase):
                 with open(os.path.join(d, "raw", name + ".tsv"), "w") as f:
                     f.write("".join("%d\t%d\n" % (k, v) for k, v in enumerate(vals)))
                 rows.append(results.row_from_samples(name, "raw", 8, 1000, vals, i, raw="raw/%s.tsv" % name,
-                                                     sent=10 * i, wire={"data_frames": 10 * i, "frames_lost": 0}))
+                                                     sent=10 * i, wire={"data_frames": 10 * i, "frames_lost": 0},
+                                                     values=10 * i, cpu_ns_per_value=1000 * i))
             rows.append(results.row_from_samples("other", "raw", 8, 1000, [1], 0))
             out = suite.merge_repeats(rows, d)
             self.assertEqual([r["name"] for r in out], ["ccomm_x", "other"])
@@ -92,6 +93,8 @@ class MergeTest(unittest.TestCase):
             self.assertEqual((m["count"], m["lost"], m["min_ns"], m["max_ns"], m["p50_ns"]), (5, 3, 10, 50, 30))
             self.assertEqual(m["sent"], 30)
             self.assertEqual(m["frames_per_cycle"], 1.0)
+            # CPU per value over both halves, weighted by their values: (10*1000 + 20*2000) / 30
+            self.assertEqual((m["cpu_ns_per_value"], m["rep_cpu_ns_per_value"], m["values"]), (1667, [1000, 2000], 30))
             self.assertEqual(len(results.load_raw(os.path.join(d, m["raw"]))), 5)
 
 
@@ -152,7 +155,7 @@ class PeersTest(unittest.TestCase):
 
         def row(name, p50, cpu):
             return {"name": name, "p50_ns": p50, "cpu_ns_per_value": cpu}
-        R = formatting.Rows([row("ccomm_udp_oneway_block_1khz_p8", 50000, 90000),
+        R = formatting.Rows([row("ccomm_udp_oneway_block_1khz_p8_vs_dds", 50000, 90000),
                              row("dds_be_oneway_1khz_p8", 60000, 80000)])
         cks = peers.checks(R, targets._check)
         by = {(c["rows"][1], c["rows"][2]): c for c in cks if "rows" in c}

@@ -99,6 +99,9 @@ uint64_t AddressSpaceRoom();
 int SocketDrops(int fd, uint32_t* drops);
 /// Touches `bytes` of stack so page faults happen at start-up, not in the loop.
 void PrefaultStack(size_t bytes);
+/// Names the calling thread (at most 15 characters shown), so that ps -L, top -H and
+/// /proc/PID/task/TID/comm tell ccommd's threads apart. Start-up only.
+void NameThisThread(const char* name);
 
 /// POSIX shm objects whose names start with `prefix` (without the leading '/'): how many,
 /// and the rest of the first one's name in `first` (`cap` bytes). Start-up only.

@@ -6,6 +6,7 @@
 #include "daemon/engine/segment_builder.h"
 
 #include <errno.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "common/platform.h"
@@ -103,6 +104,9 @@ void Daemon::StartRunning() {
 
 void Daemon::EnterIoThread(const char* name) {
   const RealtimeConfig& rt = cfg_->nodes[self_].realtime;
+  char thread_name[16];
+  snprintf(thread_name, sizeof thread_name, "ccommd-%s", name);  // ccommd-send, ccommd-receive
+  platform::NameThisThread(thread_name);
   if (!opt_.no_realtime) {
     platform::RealtimeRequest want;
     want.cpu = rt.cpu;

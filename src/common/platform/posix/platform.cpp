@@ -130,6 +130,12 @@ void CloseFd(int fd) {
   if (fd >= 0) close(fd);
 }
 
+void NameThisThread(const char* name) {
+  char shown[16];  // the kernel keeps 15 characters and the terminator
+  snprintf(shown, sizeof shown, "%s", name);
+  pthread_setname_np(pthread_self(), shown);
+}
+
 int SocketDrops(int fd, uint32_t* drops) {
   uint32_t mem[SK_MEMINFO_VARS] = {};
   socklen_t len = sizeof mem;

@@ -341,6 +341,10 @@ void CloseFd(int fd) {
   o->in_use = false;
 }
 
+// Thread descriptions (SetThreadDescription) need Windows 10 1607 and a wide string; a
+// debugger is the only place that shows them: not worth a dependency on the version.
+void NameThisThread(const char* /*name*/) {}
+
 int SocketDrops(int /*fd*/, uint32_t* /*drops*/) { return -ENOSYS; }  // Winsock counts none per socket
 
 // Named objects cannot be listed without the native API: ccomm_open() by hostname finds

@@ -335,6 +335,17 @@ def section(R, meta, problems):
                  "application's own thread and, like ccommd on board B, wakes a receive thread per packet.\n")
         from . import threads
         L += threads.table([r for r in split if r])
+        L.append("History of these comparisons (issue 38): when the issue was filed (dcb2aca, a full run on this "
+                 "machine, load 0.58) ccomm's CPU per value was over Cyclone DDS's in all eight classes: one-way "
+                 "8 B 118.1 µs vs 94.0 µs (1.26x best-effort, 1.37x reliable), one-way 288 B 128.8 vs 96.7 µs "
+                 "(1.33x, 1.52x reliable), RTT/2 1.04-1.09x. Counted over the measured window as the peers' "
+                 "CPU is, not over the programs' whole lives (11cbdb3), ccomm-latency without the thread a "
+                 "sending side does not need (9666531: its idle `ccomm_wait()` was woken by each of its own "
+                 "writes), no `recvfrom` per tick for ptp4l's answers off a PTP network (fc4569b), supervision "
+                 "on its own schedule (148236e) and a 1 s socket wait (ab82469): below DDS in 5 of 8 classes at "
+                 "6ec71d9, 7 of 8 at 3773fd0 (one run each, the ccomm rows minutes before DDS's). From this "
+                 "version on, each class is judged on three rounds alternating ccomm, DDS best-effort and DDS "
+                 "reliable, merged.\n")
     tput = [r for r in R.rows if "throughput" in r["name"]]
     if tput:
         L.append("Throughput at 8 B, one way (steps: offered values/s -> lost). Not like for like in one respect: "

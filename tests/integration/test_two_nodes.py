@@ -123,3 +123,19 @@ def test_periodic_mode_sends_once_per_period(tmp_path):
         # The writer stopped; ccommd keeps re-sending 4.5 every 5 ms, and it turns stale.
         assert wait_for(lambda: pair.echo_once("planner", "wheel2_cur") == ("4.5", "stale"), 10) is not None
         assert signal_stats(pair.stats("planner"), "wheel0_pos")["rx"] == 0  # never written
+
+
+def test_threads_named():
+    """ccommd names its I/O threads (ps -L, top -H, /proc/PID/task/TID/comm; docs/man/ccommd.8.md)."""
+    with NodePair() as pair:
+        pair.start("control")
+        pid = pair.daemons["control"].pid  # ip netns exec execs ccommd itself
+        def names():
+            out = []
+            for tid in os.listdir("/proc/%d/task" % pid):
+                with open("/proc/%d/task/%s/comm" % (pid, tid)) as f:
+                    out.append(f.read().strip())
+            return sorted(out)
+        # Each named once; any other thread is the main one, or a sanitizer's (TSan runs one).
+        assert wait_for(lambda: names().count("ccommd-send") == 1 and names().count("ccommd-receive") == 1
+                        and "ccommd" in names(), 5), names()

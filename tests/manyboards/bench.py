@@ -27,7 +27,8 @@ import topology  # noqa: E402
 def run_one(args, mode, n, transport, rate):
     a = argparse.Namespace(build=args.build, boards=n, rate=rate, seconds=args.seconds, transport=transport,
                            fanout=args.fanout, monitor="none", consumers=1, signals=4, stale_after_ms=50,
-                           stale_tolerance_ms=10, kill=False, prio=70, daemon_prio=80, work=None, latency=True)
+                           stale_tolerance_ms=10, kill=False, prio=70, daemon_prio=80, work=None, latency=True,
+                           pin=args.pin)
     r, summary = manyboards.floor(a) if mode == "floor" else manyboards.system(a)
     summary["ok"] = bool(r.checks) and all(ok for ok, _ in r.checks)
     summary["failed"] = [t for ok, t in r.checks if not ok]
@@ -70,7 +71,7 @@ def render(rows, args, meta):
          "on, the bridge its own querier); in each, one ccommd (SCHED_FIFO 80) and one application "
          "(`bench/manyboards_app.c`, SCHED_FIFO 70) that writes 4 doubles per cycle (%s Hz) and one "
          "`ccomm_flush()` per cycle, and consumes the 4 signals of the previous board in the ring: **the same work "
-         "per board for every N**. Cycles of the N boards are spread evenly over the period. Fan-out: %s. "
+         "per board for every N**. Cycles of the N boards are spread evenly over the period. Fan-out: %s. %s "
          "p50 is the median over boards of each board's median one-way latency (producer's source time to "
          "the consumer application's read, one CLOCK_MONOTONIC for all namespaces); CPU is ccommd's "
          "run time over the run (every thread's `/proc/PID/task/TID/schedstat`, ns) as %% of one core, the median over boards. "
@@ -80,7 +81,13 @@ def render(rows, args, meta):
          "some task on the host waited for a CPU (`/proc/pressure/cpu`): the VM is shared with other builds, "
          "so single 5 s runs vary (three runs on 2026-11-25 differed by up to about 30 %% per ccomm cell, the floor's "
          "small CPU figures by more)."
-         % (meta["date"], meta["commit"], meta["machine"], " and ".join("%g" % x for x in args.rates), args.fanout),
+         % (meta["date"], meta["commit"], meta["machine"], " and ".join("%g" % x for x in args.rates), args.fanout,
+            "Placement: each board's processes (ccommd's threads and the application) on one CPU, board i on CPU "
+            "i mod %d, as a single-core board (an Overo) runs them; the floor's likewise (`--no-pin`: the host "
+            "spreads them over all CPUs; measured that way on 2026-12-04, each application migrated between the CPUs "
+            "1300-1400 times a second (/proc/PID/task/TID/sched) and ccommd's per-board CPU at 1 kHz was 5.4-7.6 %% "
+            "instead of 2.7-4.1 %%, p50 at 2 boards 101-134 us instead of 54-60 us)." % os.cpu_count() if getattr(args, "pin", True) else
+            "Placement: unpinned (`--no-pin`): the host spreads each board's processes over all CPUs."),
          ""]
     for tr, rate in [(t, x) for x in args.rates for t in args.transports]:
         R = [r for r in rows if r["transport"] == tr and r["rate"] == rate]
@@ -148,6 +155,8 @@ def main():
     ap.add_argument("--boards", default="2,4,8,16")
     ap.add_argument("--transports", default="raw,udp")
     ap.add_argument("--fanout", choices=("multicast", "unicast"), default="multicast")
+    ap.add_argument("--no-pin", dest="pin", action="store_false",
+                    help="let the host spread each board's processes over all CPUs (default: board i on CPU i mod CPUs)")
     ap.add_argument("--out", help="write the Markdown section here (default: stdout)")
     ap.add_argument("--json", help="also write the measurements here")
     ap.add_argument("--from-json", help="measure nothing: render the section again from this --json file")

@@ -90,7 +90,10 @@ class Run:
 
     def spawn(self, i, cmd, log):
         f = open(os.path.join(self.work, log), "w")
-        p = subprocess.Popen(["ip", "netns", "exec", self.topo.ns(i)] + cmd, stdout=f, stderr=subprocess.STDOUT,
+        # --pin: every process of board i on CPU i mod CPUs, as a single-core board runs them
+        # (the benchmark); unpinned the host spreads one board's threads over all CPUs.
+        pin = ["taskset", "-c", str(i % os.cpu_count())] if getattr(self.args, "pin", False) else []
+        p = subprocess.Popen(["ip", "netns", "exec", self.topo.ns(i)] + pin + cmd, stdout=f, stderr=subprocess.STDOUT,
                              env=self.env)
         p.log = f.name
         self.procs.append(p)
@@ -564,6 +567,8 @@ def main():
     ap.add_argument("--no-latency", dest="latency", action="store_false",
                     help="applications without their receiver thread: no latency figures, less load")
     ap.add_argument("--work", help="directory for logs and the generated signals.xml (kept)")
+    ap.add_argument("--pin", action="store_true",
+                    help="run each board's processes on one CPU (board i on CPU i mod CPUs), as a single-core board")
     args = ap.parse_args()
     if os.geteuid() != 0:
         print("manyboards: needs root (network namespaces, raw sockets)", file=sys.stderr)

@@ -139,7 +139,7 @@ def render(rows, args, meta):
           "this kernel has no IRQ time accounting (CONFIG_IRQ_TIME_ACCOUNTING off), so the softirq work of every "
           "frame (veth, bridge, IP and UDP receive, for any board) is counted to whichever thread runs when it "
           "does, and how much of the other boards' lands on a board's ccommd depends on how the N boards' cycles "
-          "fall on the 2 CPUs, not on what the board does; per-board CPU is therefore not monotonic in N. What a "
+          "fall on the 2 CPUs, not on what the board does; per-board CPU can therefore move with N where the board's own work does not. What a "
           "board's ccommd itself does per cycle is the wake-up column (its threads' voluntary context switches "
           "over the run / cycles, median over boards: the send thread once per flush, the receive thread once "
           "per frame it consumes, the supervision tick at 100 a second) and the frame checks above (its data "

@@ -232,9 +232,10 @@ def collect_apps(procs, timeout):
     return out
 
 
-def receive_losses(r, nodes):
-    """Per node, what its ccommd counted lost on receipt: datagrams the kernel dropped at its
-    socket (socket_drops) and frames missing from its peers' sequences (frames_lost)."""
+def receiver_stats(r, nodes):
+    """Per node, from its ccommd after the run: what it counted lost on receipt (datagrams the
+    kernel dropped at its socket, socket_drops; frames missing from its peers' sequences,
+    frames_lost) and per peer (frames received, alive)."""
     out = {}
     for i, name in enumerate(nodes):
         cp = subprocess.run(["ip", "netns", "exec", r.topo.ns(i), bin_path(r.args, "ccomm"), "--node", name,
@@ -496,7 +497,7 @@ def system(args):
         cpu = {nm: cpu_seconds(p.pid) - cpu0[nm] for nm, p in daemons.items()}
         wake1 = {nm: wakeups(p.pid) for nm, p in daemons.items()}
         sent1 = r.topo.sent_counts()
-        losses = receive_losses(r, nodes)
+        losses = receiver_stats(r, nodes)
         summary.update(check_counts(r, res, n, nodes, monitor, args.fanout, sent0, sent1, cycles, pressure, losses))
         check_receive_work(r, n, nodes, args.fanout, losses, cycles)
         boards = [config.board(i) for i in range(n)]

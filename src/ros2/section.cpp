@@ -33,8 +33,13 @@ class Checker {
                         " on <ros2> (expected node, namespace, domain, publish, subscribe)");
     for (const SectionElement& c : e.children)
       Err(c.line, "unknown element <" + c.name + "> in <ros2> (it has attributes only)");
-    if (const SectionAttribute* a = e.Find("node")) out->node = a->value;
-    else Err(e.line, "<ros2> without node= (the node ccomm-ros2 runs on)");
+    if (const SectionAttribute* a = e.Find("node")) {
+      out->node = a->value;
+      // An empty name is no node; the cross-check skips sections without one.
+      if (a->value.empty()) Err(a->line, "<ros2> with an empty node= (the node ccomm-ros2 runs on)");
+    } else {
+      Err(e.line, "<ros2> without node= (the node ccomm-ros2 runs on)");
+    }
     if (const SectionAttribute* a = e.Find("namespace")) {
       std::string ns = a->value;
       while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);

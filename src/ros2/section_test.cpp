@@ -72,6 +72,8 @@ void ExpectError(const std::string& ros2, const std::string& fragment, int line 
 
 TEST(Ros2Section, ErrorsNameTheLine) {
   ExpectError("<ros2/>", "<ros2> without node=");
+  // Found by fuzz_ros2_section: an empty node= was accepted and skipped the cross-check.
+  ExpectError("<ros2 node=\"\"/>", "<ros2> with an empty node=");
   ExpectError("<ros2 node=\"nobody\"/>", "<ros2> for unknown node 'nobody'");
   ExpectError("<ros2 node=\"planner\" domain=\"233\"/>", "domain 233 out of range (expected 0..232)");
   ExpectError("<ros2 node=\"planner\" domain=\"99999999999999999999\"/>", "out of range");

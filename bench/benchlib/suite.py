@@ -251,6 +251,12 @@ SMOKE_CASES = {
 }
 
 
+# The CPU counters of a ccomm_pair row (runners.run_pair) and of a peer row (cpu_ns_partner),
+# each a sum over its window.
+CPU_COUNTERS = ("cpu_ns", "cpu_apps_ns", "cpu_daemons_ns", "window_ns",
+                "cpu_ns_whole", "cpu_apps_ns_whole", "cpu_daemons_ns_whole", "cpu_ns_partner")
+
+
 def merge_repeats(rows, outdir):
     """Join the halves of repeated cases (NAME~1, NAME~2) into one row NAME: samples
     concatenated from the raw files, counters summed, statistics recomputed."""
@@ -312,6 +318,19 @@ def merge_repeats(rows, outdir):
                 first["rep_" + key] = [r[key] for r in parts]
         if all(r.get("values") for r in parts):
             first["values"] = sum(r["values"] for r in parts)
+        # The CPU counters behind those figures summed too, so that a counter divided by
+        # the merged values is per value over every part (not the first part's over all).
+        for key in CPU_COUNTERS:
+            if all(r.get(key) is not None for r in parts):
+                first[key] = sum(r[key] for r in parts)
+        if all(r.get("cpu_daemon_threads") for r in parts):
+            th = {}
+            for r in parts:
+                for role, c in r["cpu_daemon_threads"].items():
+                    t = th.setdefault(role, {"run_ns": 0, "times_run": 0})
+                    t["run_ns"] += c["run_ns"]
+                    t["times_run"] += c["times_run"]
+            first["cpu_daemon_threads"] = th
         if any(r.get("threads") for r in parts):
             first["threads"] = [s for r in parts for s in (r.get("threads") or [])]
         first["seconds"] = round(sum(r.get("seconds", 0) for r in parts), 2)

@@ -85,7 +85,11 @@ class MergeTest(unittest.TestCase):
                     f.write("".join("%d\t%d\n" % (k, v) for k, v in enumerate(vals)))
                 rows.append(results.row_from_samples(name, "raw", 8, 1000, vals, i, raw="raw/%s.tsv" % name,
                                                      sent=10 * i, wire={"data_frames": 10 * i, "frames_lost": 0},
-                                                     values=10 * i, cpu_ns_per_value=1000 * i))
+                                                     values=10 * i, cpu_ns_per_value=1000 * i,
+                                                     cpu_ns=10000 * i * i, cpu_apps_ns=4000 * i * i,
+                                                     cpu_daemons_ns=6000 * i * i, window_ns=10 ** 9,
+                                                     cpu_daemon_threads={"send": {"run_ns": 100 * i,
+                                                                                  "times_run": i}}))
             rows.append(results.row_from_samples("other", "raw", 8, 1000, [1], 0))
             out = suite.merge_repeats(rows, d)
             self.assertEqual([r["name"] for r in out], ["ccomm_x", "other"])
@@ -95,6 +99,11 @@ class MergeTest(unittest.TestCase):
             self.assertEqual(m["frames_per_cycle"], 1.0)
             # CPU per value over both halves, weighted by their values: (10*1000 + 20*2000) / 30
             self.assertEqual((m["cpu_ns_per_value"], m["rep_cpu_ns_per_value"], m["values"]), (1667, [1000, 2000], 30))
+            # The counters behind it summed, so that counter / values is per value over both.
+            self.assertEqual((m["cpu_ns"], m["cpu_apps_ns"], m["cpu_daemons_ns"], m["window_ns"]),
+                             (50000, 20000, 30000, 2 * 10 ** 9))
+            self.assertEqual(round(m["cpu_ns"] / m["values"]), m["cpu_ns_per_value"])
+            self.assertEqual(m["cpu_daemon_threads"], {"send": {"run_ns": 300, "times_run": 3}})
             self.assertEqual(len(results.load_raw(os.path.join(d, m["raw"]))), 5)
 
 

@@ -343,9 +343,12 @@ def section(R, meta, problems):
                  "sending side does not need (9666531: its idle `ccomm_wait()` was woken by each of its own "
                  "writes), no `recvfrom` per tick for ptp4l's answers off a PTP network (fc4569b), supervision "
                  "on its own schedule (148236e) and a 1 s socket wait (ab82469): below DDS in 5 of 8 classes at "
-                 "6ec71d9, 7 of 8 at 3773fd0 (one run each, the ccomm rows minutes before DDS's). From this "
-                 "version on, each class is judged on three rounds alternating ccomm, DDS best-effort and DDS "
-                 "reliable, merged.\n")
+                 "6ec71d9, 7 of 8 at 3773fd0 (one run each, the ccomm rows minutes before DDS's). From 6646eaa "
+                 "on, each class is judged on rounds alternating ccomm, DDS best-effort and DDS reliable, merged "
+                 "(three, then five: suite.PEER_ROUNDS, each round's figure kept as `rep_cpu_ns_per_value`); "
+                 "from this version on, the supervision no longer ticks every 10 ms while this node's signals "
+                 "are written (the summary reads a produced signal's age off its newest value), which took "
+                 "board A's ccommd main thread from 100 wake-ups a second to 10.\n")
     tput = [r for r in R.rows if "throughput" in r["name"]]
     if tput:
         L.append("Throughput at 8 B, one way (steps: offered values/s -> lost). Not like for like in one respect: "

@@ -142,7 +142,7 @@ def render(rows, args, meta):
           "fall on the 2 CPUs, not on what the board does; per-board CPU can therefore move with N where the board's own work does not. What a "
           "board's ccommd itself does per cycle is the wake-up column (its threads' voluntary context switches "
           "over the run / cycles, median over boards: the send thread once per flush, the receive thread once "
-          "per frame it consumes, the supervision tick at 100 a second) and the frame checks above (its data "
+          "per frame it consumes, the supervision tick about 10 a second) and the frame checks above (its data "
           "frames, and none of the data of boards that only consume from it): both constant in N.", ""]
     return "\n".join(L) + "\n", checks
 

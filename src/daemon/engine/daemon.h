@@ -59,7 +59,7 @@ class Daemon {
   void RunTx();   // send thread body, returns after RequestStop()
   void RunRx();   // receive thread body
   /// Supervision: daemon heartbeat, peer liveness, staleness counters. Call again at
-  /// NextSupervisionNs() (Supervisor::NextTickNs: 10 ms while busy, at most 100 ms idle).
+  /// NextSupervisionNs() (Supervisor::NextTickNs: when something falls due, at most 100 ms).
   void Supervise(uint64_t now_ns) { supervisor_.Tick(now_ns); }
   uint64_t NextSupervisionNs() const { return supervisor_.NextTickNs(); }
   /// What supervision hands the receive thread for stale_by="production" (tests call it too).

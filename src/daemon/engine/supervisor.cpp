@@ -121,8 +121,10 @@ void Supervisor::Tick(uint64_t now) {
   if (ptp_.NextDueNs() < due) due = ptp_.NextDueNs();
   const uint64_t by_arrival = ctx_.handoffs.by_arrival_frames.load(std::memory_order_relaxed);
   if (by_arrival != by_arrival_logged_ && by_arrival_next_log_ns_ < due) due = by_arrival_next_log_ns_;
-  const bool busy = now - ctx_.view.last_write_seen_ns() < kBusyForNs || ctx_.handoffs.send_cycle.enabled();
-  next_tick_ns_ = busy || due < now + kTickNs ? now + kTickNs : due;
+  // The send cycle is supervised every tick (SuperviseSendCycle); nothing else needs a
+  // fixed tick: a produced signal's age is read off its newest value (SystemViewWriter).
+  const bool fixed = ctx_.handoffs.send_cycle.enabled();
+  next_tick_ns_ = fixed || due < now + kTickNs ? now + kTickNs : due;
 }
 
 // This board's clock state (ptp_state.h) into its segment, where ccomm_get_clock_state()

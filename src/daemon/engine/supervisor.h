@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // ccommd's supervision part (supervisor.cpp), run by the main thread on its own schedule
-// (NextTickNs: every 10 ms while this node's signals are written, else when something
-// falls due, at least every 100 ms): the daemon heartbeat in the segment, peer liveness against peer_timeout_ms, stale
+// (NextTickNs: when something falls due, at least every 100 ms; every 10 ms while the
+// send cycle runs): the daemon heartbeat in the segment, peer liveness against peer_timeout_ms, stale
 // transitions of consumed signals, the reclaim of slots left by dead writers, the
 // kernel's drop count, frames of other transports (foreign_frames.h), this board's
 // clock (ptp_state.h) and the log lines of what the receive thread counted (at most
@@ -46,16 +46,15 @@ class Supervisor {
   /// One supervision tick.
   void Tick(uint64_t now);
   /// When the next tick is due, as the last Tick() planned it. Every kTickNs (as a fixed
-  /// tick would) while a produced signal was written within kBusyForNs (the system view
-  /// samples its age per tick), while the send cycle runs or ptp4l's answers are due;
-  /// otherwise at the earliest instant something falls due (a peer's timeout, a consumed
-  /// signal going stale, a summary, a poll, a log line held back), at most kIdleTickNs
-  /// ahead (the daemon heartbeat: ccomm_daemon_alive allows 1 s), never sooner than
-  /// kTickNs. Idle, that is 10 wake-ups a second instead of 100.
+  /// tick would) while the send cycle runs or ptp4l's answers are due; otherwise at the
+  /// earliest instant something falls due (a peer's timeout, a consumed signal going
+  /// stale, a summary, a poll, a log line held back), at most kIdleTickNs ahead (the
+  /// daemon heartbeat: ccomm_daemon_alive allows 1 s), never sooner than kTickNs. Writes
+  /// of this node's signals change nothing (the summary reads a produced signal's age
+  /// off its newest value): idle or producing at 1 kHz, about 10 wake-ups a second.
   uint64_t NextTickNs() const { return next_tick_ns_; }
   static constexpr uint64_t kTickNs = 10'000'000;
   static constexpr uint64_t kIdleTickNs = 100'000'000;
-  static constexpr uint64_t kBusyForNs = 1'000'000'000;
   void Stop() { foreign_.Close(); }
 
  private:

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The supervision's schedule (Supervisor::NextTickNs) on a real Daemon over loopback UDP:
-// idle it ticks every 100 ms, not every 10 ms; a write of a produced signal brings the
-// 10 ms tick back for a second; a consumed signal going stale and a peer's timeout are
-// ticked at their instant (counted then), not up to 100 ms later.
+// idle or while a produced signal is written it ticks every 100 ms, not every 10 ms (the
+// summary reads the signal's age off its newest value); a consumed signal going stale and
+// a peer's timeout are ticked at their instant (counted then), not up to 100 ms later.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -15,6 +15,8 @@
 #include "daemon/engine/daemon.h"
 #include "daemon/engine/receiving_daemon_fixture.h"
 #include "daemon/engine/supervisor.h"
+#include "store/state_slot.h"
+#include "store/view.h"
 #include "testing/test_config.h"
 #include "wire/wire.h"
 
@@ -35,9 +37,10 @@ class SupervisorScheduleTest : public testing::ReceivingDaemonTest {
     StartDaemon("supsched", {pos, sp});
     started_ns_ = platform::MonotonicNs();
   }
-  // The first second after the start ticks every 10 ms (Supervisor::kBusyForNs): past it.
+  // Past the start's own due work (the first summary parts), so that what a test plans
+  // is the only thing due.
   void WaitPastTheFirstSecond() {
-    while (platform::MonotonicNs() < started_ns_ + Supervisor::kBusyForNs + 5 * kMs) usleep(20000);
+    while (platform::MonotonicNs() < started_ns_ + 1005 * kMs) usleep(20000);
   }
   // One frame from b carrying sp = v; returns once the receive thread stored it.
   void SendSp(uint32_t seq, double v) {
@@ -54,9 +57,22 @@ class SupervisorScheduleTest : public testing::ReceivingDaemonTest {
     ASSERT_EQ(Stats(kSp).rx.load(), rx_before + 1);
   }
   const store::SignalStats& Stats(uint32_t id) { return daemon_.segment().stats(id); }
-  // An application's write of pos as the library counts it (the segment is shared memory a
-  // client writes into; the daemon only reads the counter).
-  void CountWriteOfPos() { const_cast<store::Segment&>(daemon_.segment()).stats(kPos).writes.fetch_add(1); }
+  // An application's write of pos as the library makes it: the value into its state cell,
+  // stamped with its write time `at`, and counted (the daemon only reads the segment).
+  void WriteOfPos(double v, uint64_t at) {
+    store::Segment& seg = const_cast<store::Segment&>(daemon_.segment());
+    ASSERT_EQ(store::StateWrite(seg.state(kPos), &v, 0, at, at), store::StoreResult::kOk);
+    seg.stats(kPos).writes.fetch_add(1);
+  }
+  // pos's age in this node's own record of the system view, as the last tick wrote it.
+  uint32_t AgeOfPosMs() {
+    store::View v;
+    EXPECT_EQ(v.OpenReadOnly(store::View::NameFor("a")), 0);
+    store::ViewRowCopy row;
+    EXPECT_TRUE(v.ReadRow(0, kPos, &row));
+    EXPECT_TRUE(row.present);
+    return row.age_ms;
+  }
   uint64_t started_ns_ = 0;
   uint64_t Tick(uint64_t now) {
     daemon_.Supervise(now);
@@ -64,15 +80,16 @@ class SupervisorScheduleTest : public testing::ReceivingDaemonTest {
   }
 };
 
-TEST_F(SupervisorScheduleTest, IdleTicksEvery100msAndAWriteBringsBack10ms) {
+TEST_F(SupervisorScheduleTest, IdleOrWrittenTicksEvery100ms) {
   // One second of ticks, each at the instant the last one planned; `write`: pos is
   // written before every tick (as a 100 Hz or faster writer would).
-  uint64_t now = platform::MonotonicNs() + 2000 * kMs;  // past the first second after the start
+  uint64_t now = platform::MonotonicNs() + 2000 * kMs;
+  double v = 0;
   auto second = [&](bool write) {
     int ticks = 0;
     uint64_t longest = 0;
     for (const uint64_t end = now + 1000 * kMs; now < end; ++ticks) {
-      if (write) CountWriteOfPos();
+      if (write) WriteOfPos(v += 1, now);
       const uint64_t wait = Tick(now);
       EXPECT_GE(wait, Supervisor::kTickNs);
       EXPECT_LE(wait, Supervisor::kIdleTickNs);
@@ -84,14 +101,22 @@ TEST_F(SupervisorScheduleTest, IdleTicksEvery100msAndAWriteBringsBack10ms) {
   auto idle = second(false);
   EXPECT_LE(idle.first, 11) << "idle: about 10 ticks a second";
   EXPECT_EQ(idle.second, Supervisor::kIdleTickNs);
-  auto busy = second(true);
-  EXPECT_EQ(busy.first, 100) << "written: every 10 ms, as before";
-  EXPECT_EQ(busy.second, Supervisor::kTickNs);
-  // The last write a second ago: 10 ms ticks until then, idle after.
-  auto after = second(false);
-  EXPECT_GE(after.first, 90);
-  EXPECT_LE(after.first, 100);
-  EXPECT_LE(second(false).first, 11);
+  EXPECT_EQ(AgeOfPosMs(), wire::kSummaryNoAge) << "never written";
+  // Written: no more ticks than idle (they used to come every 10 ms for a second after a
+  // write, to sample when the writes advanced).
+  auto written = second(true);
+  EXPECT_LE(written.first, 11) << "written: about 10 ticks a second, as idle";
+  EXPECT_EQ(written.second, Supervisor::kIdleTickNs);
+  // The age in the summary is read off the value's own write time, to the ms: written
+  // 250 ms before the tick that reports it.
+  const uint64_t written_at = now;
+  WriteOfPos(v += 1, written_at);
+  now = written_at + 250 * kMs;
+  while (daemon_.NextSupervisionNs() > now) now = daemon_.NextSupervisionNs();  // the tick at or after +250 ms
+  Tick(now);
+  const uint32_t age = AgeOfPosMs();
+  EXPECT_EQ(age, (now - written_at) / kMs);
+  EXPECT_GE(age, 250u);
 }
 
 TEST_F(SupervisorScheduleTest, StaleAndPeerTimeoutAreTickedAtTheirInstant) {

@@ -7,7 +7,9 @@
 
 #include "common/platform.h"
 #include "daemon/clock/ptp_state.h"
+#include "store/event_ring.h"
 #include "store/freshness.h"
+#include "store/state_slot.h"
 
 namespace ccomm {
 namespace {
@@ -63,10 +65,16 @@ int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKin
     }
     const store::SignalStats& st = segment->stats(i);
     rep.last_count = rep.role == wire::kRoleProduced ? st.writes.load() : st.rx.load();
-    rep.seen_writes = st.writes.load();
-    rep.last_change_ns = rep.seen_writes ? start_ns_ : 0;
     reported_.push_back(rep);
   }
+  // Room for the largest produced value, the copy NewestWriteNs reads a stamp with.
+  size_t largest = 0;
+  for (const Reported& rep : reported_)
+    if (rep.role == wire::kRoleProduced && segment->dir(rep.id).value_bytes > largest)
+      largest = segment->dir(rep.id).value_bytes;
+  scratch_.assign((largest + 7) / 8, 0);
+  for (Reported& rep : reported_)  // a re-adopted segment: its values keep their time
+    if (rep.role == wire::kRoleProduced) rep.last_write_ns = NewestWriteNs(rep.id);
   const size_t per = wire::kSummaryMaxRecords;
   parts_ = reported_.empty() ? 1 : static_cast<uint32_t>((reported_.size() + per - 1) / per);
   if (cfg.network.summary_ms == 0) {
@@ -107,7 +115,6 @@ int SystemViewWriter::Start(const SystemConfig& cfg, uint32_t self, TransportKin
     dests_.push_back(d);
   }
   next_ns_ = start_ns_;
-  last_write_seen_ns_ = start_ns_;  // the first second after a start ticks every 10 ms
   cycle_start_ns_ = start_ns_;
   next_part_ = 0;
   return 0;
@@ -126,16 +133,25 @@ void SystemViewWriter::Snapshot(uint64_t now) {
   cycle_start_ns_ = now;
 }
 
-uint32_t SystemViewWriter::Tick(uint64_t now) {
-  for (Reported& rep : reported_) {  // when did a produced signal last change (tick resolution)
-    if (rep.role != wire::kRoleProduced) continue;
-    const uint64_t w = segment_->stats(rep.id).writes.load(std::memory_order_relaxed);
-    if (w != rep.seen_writes) {
-      rep.seen_writes = w;
-      rep.last_change_ns = now;
-      last_write_seen_ns_ = now;
-    }
+// The write time its writer stamped on the newest value of produced signal `id` (its
+// local_time_ns), or 0 if none can be read (never written, or being rewritten: the
+// caller keeps what it had). Read when a record is built, not sampled per tick, so the
+// supervision need not wake while the signal is written (Supervisor::NextTickNs).
+uint64_t SystemViewWriter::NewestWriteNs(uint32_t id) {
+  store::SlotMeta meta;
+  if (segment_->dir(id).flags & store::kSigEvent) {
+    const store::RingView ring = segment_->ring(id);
+    const uint64_t head = ring.ring->head.load(std::memory_order_acquire);
+    for (uint64_t t = head; t > 0 && head - t < 2; --t)  // the newest event, or the one before it if that is mid-write
+      if (store::ReadSlot(ring.slot(t - 1), t - 1, ring.value_bytes, scratch_.data(), &meta) == store::CopyResult::kOk)
+        return meta.local_time_ns;
+    return 0;
   }
+  return store::StateRead(segment_->state(id), scratch_.data(), &meta) == store::StoreResult::kOk ? meta.local_time_ns
+                                                                                                  : 0;
+}
+
+uint32_t SystemViewWriter::Tick(uint64_t now) {
   if (now < next_ns_) return 0;
   next_ns_ = now + interval_ns_;
   if (next_part_ == 0) Snapshot(now);
@@ -184,7 +200,8 @@ uint32_t SystemViewWriter::Tick(uint64_t now) {
     rec.flags = 0;
     if (rep.role == wire::kRoleProduced) {
       rec.lost = st.write_errors.load(std::memory_order_relaxed);
-      rec.age_ms = rep.seen_writes ? AgeMs(rep.last_change_ns, now) : wire::kSummaryNoAge;
+      if (const uint64_t t = NewestWriteNs(rep.id)) rep.last_write_ns = t;
+      rec.age_ms = AgeMs(rep.last_write_ns, now);  // 0: never written (kSummaryNoAge)
     } else {
       rec.lost = st.lost.load(std::memory_order_relaxed);
       rec.age_ms = AgeMs(st.last_rx_ns.load(std::memory_order_relaxed), now);

@@ -55,10 +55,8 @@ class SystemViewWriter {
   uint64_t interval_ns() const { return interval_ns_; }
   uint32_t parts() const { return parts_; }
   /// For the supervision's schedule (Supervisor::NextTickNs): when Tick next sends a part
-  /// or refreshes this node's record, and the last tick that saw a produced signal's
-  /// writes advance (0: none yet), whose age it samples.
+  /// or refreshes this node's record.
   uint64_t next_due_ns() const { return next_ns_; }
-  uint64_t last_write_seen_ns() const { return last_write_seen_ns_; }
 
  private:
   struct Dest {
@@ -70,8 +68,7 @@ class SystemViewWriter {
     uint32_t id = 0;
     uint8_t role = 0;
     uint64_t last_count = 0;     // writes (produced) / rx (consumed) at the last cycle start
-    uint64_t last_change_ns = 0; // produced: when writes last advanced (sampled per tick)
-    uint64_t seen_writes = 0;
+    uint64_t last_write_ns = 0;  // produced: its newest value's write time (NewestWriteNs), 0 = never
     wire::SummaryRecord rec;     // as of the current cycle's start
   };
   struct SenderState {
@@ -81,6 +78,7 @@ class SystemViewWriter {
   };
 
   void Snapshot(uint64_t now);
+  uint64_t NewestWriteNs(uint32_t id);
   void SendPart(uint32_t part, uint64_t now);
   void SetHeadWords(uint32_t node, const wire::SummaryHead& head);  // the head's words; inside Begin/EndWrite
   void WriteSelf(const wire::SummaryHead& head, uint32_t first, uint32_t end, uint64_t now);
@@ -95,7 +93,7 @@ class SystemViewWriter {
   std::vector<Reported> reported_;
   std::vector<SenderState> senders_;
   uint64_t start_ns_ = 0, interval_ns_ = 0, next_ns_ = 0, cycle_start_ns_ = 0;
-  uint64_t last_write_seen_ns_ = 0;
+  std::vector<uint64_t> scratch_;  // the largest produced value (NewestWriteNs)
   uint32_t parts_ = 0, next_part_ = 0;
   wire::SummaryHead head_;  // node-level part of the current cycle
   alignas(8) uint8_t buf_[wire::kMaxFrameSize];
